@@ -1,0 +1,63 @@
+//! Orthonormal frame (`s`, `t`, `n`): converts between world and local shading coordinates,
+//! where the local normal is +Z (Mitsuba's `Frame3f`).
+
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    pub s: Vec3,
+    pub t: Vec3,
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// Frame around a unit normal (Duff et al. 2017, "Building an orthonormal basis, revisited").
+    #[inline]
+    pub fn from_normal(n: Vec3) -> Frame {
+        let sign = 1.0f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        Frame { s, t, n }
+    }
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+    #[inline]
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.s * v.x + self.t * v.y + self.n * v.z
+    }
+    #[inline]
+    pub fn cos_theta(v: Vec3) -> f32 {
+        v.z
+    }
+    #[inline]
+    pub fn cos_theta_2(v: Vec3) -> f32 {
+        v.z * v.z
+    }
+    #[inline]
+    pub fn sin_theta_2(v: Vec3) -> f32 {
+        (1.0 - v.z * v.z).max(0.0)
+    }
+    #[inline]
+    pub fn tan_theta_2(v: Vec3) -> f32 {
+        Self::sin_theta_2(v) / (v.z * v.z)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn orthonormal() {
+        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, -0.5, 0.8).normalize()] {
+            let f = Frame::from_normal(n);
+            assert!(f.s.dot(f.t).abs() < 1e-6 && f.s.dot(f.n).abs() < 1e-6 && f.t.dot(f.n).abs() < 1e-6);
+            assert!((f.s.cross(f.t) - f.n).length() < 1e-5);
+            let v = Vec3::new(0.1, 0.7, -0.2);
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-6);
+        }
+    }
+}

@@ -1,0 +1,7 @@
+//! Scene loading: XML parsing ([`xml`]), typed properties ([`desc`]), errors ([`error`]).
+
+pub mod desc;
+pub mod error;
+pub mod resolver;
+
+pub use error::{Error, Result, SrcPos};
