@@ -2,11 +2,18 @@
 //! inside a refractive boundary), with Subdivision Next-Event Estimation (Koerner et al. 2016).
 //!
 //! Data flow: `scene.xml` → [`scene::xml`] (tree with positions) → [`scene::desc`] (typed properties)
-//! → [`scene::build`] (meshes, BVH, plugins) → [`render`] (tiles, film) → EXR.
+//! → scene build (meshes, BVH, plugins) → render (tiles, film) → EXR.
 
+pub mod bsdf;
 pub mod color;
+pub mod emitter;
 pub mod interaction;
+pub mod io;
 pub mod math;
 pub mod sampler;
 pub mod scene;
+pub mod sensor;
+pub mod shape;
+#[doc(hidden)]
+pub mod testing;
 pub mod texture;

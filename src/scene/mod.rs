@@ -3,5 +3,6 @@
 pub mod desc;
 pub mod error;
 pub mod resolver;
+pub mod xml;
 
 pub use error::{Error, Result, SrcPos};

@@ -1,0 +1,1 @@
+//! Emitters: directional, envmap, constant, point, spot (area emitters live with their shapes).

@@ -1,0 +1,1 @@
+//! Reading images (EXR, PNG) into float RGB(A) bitmaps.

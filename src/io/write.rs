@@ -1,0 +1,1 @@
+//! Writing images: float32 EXR with optional extra channels, sRGB PNG previews.

@@ -1,0 +1,1 @@
+//! Mitsuba 3 XML parser: text → ObjectDesc tree with positions.

@@ -1,0 +1,1 @@
+//! Sensors and film: perspective camera, hdrfilm, reconstruction filters.

@@ -1,0 +1,1 @@
+//! Triangle mesh data as loaded from a file, before transformation.

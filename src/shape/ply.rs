@@ -1,0 +1,1 @@
+//! PLY loader (ascii and binary).

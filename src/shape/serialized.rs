@@ -1,0 +1,1 @@
+//! Mitsuba's `.serialized` mesh format loader.

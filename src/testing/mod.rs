@@ -1,0 +1,1 @@
+//! Statistical test helpers shared by unit and integration tests (chi-square over the sphere).
