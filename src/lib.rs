@@ -6,10 +6,15 @@
 
 pub mod bsdf;
 pub mod color;
+pub mod compare;
 pub mod emitter;
+pub mod integrator;
 pub mod interaction;
+pub mod info;
 pub mod io;
 pub mod math;
+pub mod render;
+pub mod medium;
 pub mod sampler;
 pub mod scene;
 pub mod sensor;

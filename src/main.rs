@@ -1,1 +1,184 @@
-fn main() {}
+//! `snee` command line: `info`, `render`, `compare`. All work happens in the library; this file
+//! parses arguments, calls it, and prints errors as `file:line:col: message`.
+
+use anyhow::{anyhow, Context};
+use clap::{Parser, Subcommand};
+use snee::scene::build::load_scene;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// The scene rendered when `render` is given no scene file.
+const DEFAULT_SCENE: &str = "scenes/default.xml";
+
+#[derive(Parser)]
+#[command(name = "snee", version, about = "Renders Mitsuba 3 scenes: translucent objects with Subdivision Next-Event Estimation")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print a summary of a scene: plugins, triangles, bounds, media, emitters, film and samples.
+    Info {
+        scene: PathBuf,
+        /// Override a <default> parameter (like Mitsuba's -D name=value).
+        #[arg(short = 'D', value_name = "NAME=VALUE")]
+        define: Vec<String>,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Render a scene to an EXR file.
+    Render {
+        /// Scene file (default: scenes/default.xml).
+        scene: Option<PathBuf>,
+        /// Output EXR (default: the scene name with .exr in the working directory).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        #[arg(short = 'D', value_name = "NAME=VALUE")]
+        define: Vec<String>,
+        /// Samples per pixel (default: the scene's sampler sample_count).
+        #[arg(long)]
+        spp: Option<u32>,
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Time budget in seconds: stop then and write the samples done.
+        #[arg(long, value_name = "SECONDS")]
+        time: Option<f64>,
+        /// Write render statistics as JSON.
+        #[arg(long, value_name = "FILE.json")]
+        stats: Option<PathBuf>,
+        /// Also write an sRGB PNG preview beside the EXR.
+        #[arg(long)]
+        png: bool,
+        /// No progress bar.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Compare two EXR images: MSE, relMSE, mean ratio, and a per-pixel Z-test when variances are present.
+    Compare {
+        a: PathBuf,
+        b: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn parse_defines(defs: &[String]) -> anyhow::Result<Vec<(String, String)>> {
+    defs.iter()
+        .map(|d| {
+            let (k, v) = d.split_once('=').ok_or_else(|| anyhow!("-D expects NAME=VALUE, got \"{}\"", d))?;
+            if k.is_empty() {
+                return Err(anyhow!("-D expects NAME=VALUE, got \"{}\"", d));
+            }
+            Ok((k.to_string(), v.to_string()))
+        })
+        .collect()
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // Scene errors already read `file:line:col: message`.
+            match e.downcast_ref::<snee::scene::Error>() {
+                Some(se) if se.pos.is_some() => eprintln!("{}", se),
+                _ => eprintln!("error: {:#}", e),
+            }
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Info { scene, define, json } => {
+            let defines = parse_defines(&define)?;
+            let parsed = snee::scene::xml::parse_file(&scene, &defines)?;
+            let built = snee::scene::build::build_scene(&parsed)?;
+            let summary = snee::info::summary(&parsed, &built);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&summary.to_json())?);
+            } else {
+                print!("{}", summary.to_text());
+            }
+            Ok(())
+        }
+        Command::Render { scene, output, define, spp, seed, threads, time, stats, png, quiet } => {
+            let scene_path = scene.unwrap_or_else(|| PathBuf::from(DEFAULT_SCENE));
+            let defines = parse_defines(&define)?;
+            let loaded = load_scene(&scene_path, &defines)?;
+            snee::render::check_renderable(&loaded).map_err(|e| anyhow!("{}: {}", scene_path.display(), e))?;
+            if let Some(t) = threads {
+                rayon::ThreadPoolBuilder::new().num_threads(t.max(1)).build_global().context("setting up threads")?;
+            }
+            if let Some(t) = time {
+                if !(t > 0.0 && t.is_finite()) {
+                    return Err(anyhow!("--time expects a positive number of seconds"));
+                }
+            }
+            let output = output.unwrap_or_else(|| {
+                PathBuf::from(scene_path.file_stem().map(|s| s.to_os_string()).unwrap_or_else(|| "render".into()))
+                    .with_extension("exr")
+            });
+            let cancel = Arc::new(AtomicBool::new(false));
+            {
+                let c = cancel.clone();
+                // A second Ctrl-C while writing is ignored; the first stops the render and writes what is done.
+                let _ = ctrlc::set_handler(move || c.store(true, Ordering::Relaxed));
+            }
+            let opts = snee::render::RenderOptions { spp, seed, time_budget: time, progress: !quiet };
+            let out = snee::render::render(&loaded, &opts, &cancel);
+            write_output(&output, &out, png)?;
+            let st = out.stats.to_json();
+            if let Some(p) = stats {
+                std::fs::write(&p, serde_json::to_string_pretty(&st)?).with_context(|| format!("writing {}", p.display()))?;
+            }
+            if !quiet {
+                eprintln!(
+                    "wrote {} ({}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {} rejected samples)",
+                    output.display(),
+                    out.width,
+                    out.height,
+                    out.stats.spp,
+                    out.stats.seconds,
+                    out.stats.samples as f64 / out.stats.seconds.max(1e-9) / 1e6,
+                    out.stats.rejected_samples
+                );
+            }
+            Ok(())
+        }
+        Command::Compare { a, b, json } => {
+            let ia = snee::io::read::read_image(&a, false)?;
+            let ib = snee::io::read::read_image(&b, false)?;
+            let r = snee::compare::compare(&ia, &ib).map_err(|e| anyhow!(e))?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&r.to_json())?);
+            } else {
+                print!("{}", r.to_text());
+            }
+            Ok(())
+        }
+    }
+}
+
+fn write_output(path: &Path, out: &snee::render::RenderOutput, png: bool) -> anyhow::Result<()> {
+    let names: Vec<&str> = out.channels.iter().map(|s| s.as_str()).collect();
+    snee::io::write::write_exr(path, out.width, out.height, &names, &out.data)
+        .with_context(|| format!("writing {}", path.display()))?;
+    if png {
+        let n = out.channels.len();
+        let rgb: Vec<f32> = out.data.chunks(n).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        let png_path = path.with_extension("png");
+        snee::io::write::write_png(&png_path, out.width, out.height, &rgb)
+            .with_context(|| format!("writing {}", png_path.display()))?;
+    }
+    Ok(())
+}

@@ -1,6 +1,103 @@
-//! Shapes: triangle meshes (PLY, OBJ, Mitsuba `.serialized`) and Mitsuba's analytic shapes.
+//! Shapes: triangle meshes (PLY, OBJ, Mitsuba `.serialized`, and the `rectangle` / `cube` meshes)
+//! and Mitsuba's analytic `sphere` and `disk`, each with its BSDF, optional area emitter and
+//! interior / exterior media.
 
+pub mod accel;
+pub mod disk;
+pub mod mesh;
 pub mod mesh_data;
 pub mod obj;
 pub mod ply;
 pub mod serialized;
+pub mod sphere;
+
+use crate::interaction::{DirectionSample, PositionSample, SurfaceInteraction};
+use crate::math::{Aabb, Ray, Vec2, Vec3};
+pub use disk::Disk;
+pub use mesh::Mesh;
+pub use sphere::Sphere;
+
+#[derive(Clone, Debug)]
+pub enum Geometry {
+    Mesh(Mesh),
+    Sphere(Sphere),
+    Disk(Disk),
+}
+
+/// A shape in the scene with indices into the scene's BSDF, emitter and medium arrays.
+#[derive(Clone, Debug)]
+pub struct Shape {
+    pub geometry: Geometry,
+    /// Mitsuba plugin name (`ply`, `sphere`, ...), for summaries.
+    pub plugin: String,
+    pub id: Option<String>,
+    pub bsdf: u32,
+    pub emitter: Option<u32>,
+    pub interior: Option<u32>,
+    pub exterior: Option<u32>,
+}
+
+impl Shape {
+    pub fn bounds(&self) -> Aabb {
+        match &self.geometry {
+            Geometry::Mesh(m) => m.bounds(),
+            Geometry::Sphere(s) => s.bounds(),
+            Geometry::Disk(d) => d.bounds(),
+        }
+    }
+
+    pub fn surface_area(&self) -> f32 {
+        match &self.geometry {
+            Geometry::Mesh(m) => m.surface_area(),
+            Geometry::Sphere(s) => s.surface_area(),
+            Geometry::Disk(d) => d.surface_area(),
+        }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        match &self.geometry {
+            Geometry::Mesh(m) => m.triangle_count(),
+            _ => 0,
+        }
+    }
+
+    /// Number of BVH primitives (triangles, or 1 for an analytic shape).
+    pub fn primitive_count(&self) -> usize {
+        match &self.geometry {
+            Geometry::Mesh(m) => m.triangle_count(),
+            _ => 1,
+        }
+    }
+
+    pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray: &Ray) -> SurfaceInteraction {
+        match &self.geometry {
+            Geometry::Mesh(m) => m.interaction(prim, b1, b2, t, ray.d),
+            Geometry::Sphere(s) => s.interaction(t, ray),
+            Geometry::Disk(d) => d.interaction(t, ray),
+        }
+    }
+
+    pub fn sample_position(&self, sample: Vec2) -> PositionSample {
+        match &self.geometry {
+            Geometry::Mesh(m) => m.sample_position(sample),
+            Geometry::Sphere(s) => s.sample_position(sample),
+            Geometry::Disk(d) => d.sample_position(sample),
+        }
+    }
+
+    /// A point on the shape seen from `ref_p`, with its solid-angle density (Mitsuba's `Shape::sample_direction`).
+    pub fn sample_direction(&self, ref_p: Vec3, sample: Vec2) -> DirectionSample {
+        match &self.geometry {
+            Geometry::Sphere(s) => s.sample_direction(ref_p, sample),
+            _ => sphere::area_to_direction_sample(ref_p, self.sample_position(sample)),
+        }
+    }
+
+    /// Solid-angle density of `ds` (a point on this shape seen from `ref_p`) under `sample_direction`.
+    pub fn pdf_direction(&self, ref_p: Vec3, ds: &DirectionSample) -> f32 {
+        match &self.geometry {
+            Geometry::Sphere(s) => s.pdf_direction(ref_p, ds),
+            _ => sphere::area_pdf_to_solid_angle(1.0 / self.surface_area(), ds.dist, ds.d, ds.n),
+        }
+    }
+}

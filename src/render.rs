@@ -1,0 +1,210 @@
+//! The render loop: rayon over 16×16 tiles in passes of samples per pixel, filtered accumulation
+//! into the film, a progress bar, a time budget, Ctrl-C, and render statistics.
+//!
+//! Determinism: every (pixel, pass) has its own sampler stream derived from the seed, so an image
+//! depends only on the seed and the sample count, never on the thread count or tile order.
+
+use crate::color::Spectrum;
+use crate::integrator::stats::{LocalStats, Stats};
+use crate::integrator::{path, volpath, IntegratorKind};
+use crate::math::Vec2;
+use crate::sampler::Sampler;
+use crate::scene::world::Scene;
+use crate::sensor::image_block::ImageBlock;
+use crate::sensor::film::PixelFormat;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+const TILE: u32 = 16;
+
+#[derive(Clone, Debug, Default)]
+pub struct RenderOptions {
+    /// Samples per pixel; `None` = the scene's sampler `sample_count` (unbounded with a time budget).
+    pub spp: Option<u32>,
+    pub seed: u64,
+    /// Stop after this many seconds (the image of the samples done is returned).
+    pub time_budget: Option<f64>,
+    pub progress: bool,
+}
+
+/// A rendered image with its channels and the render statistics.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    pub width: usize,
+    pub height: usize,
+    pub channels: Vec<String>,
+    /// Interleaved channels, row 0 = top.
+    pub data: Vec<f32>,
+    pub stats: RenderStats,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct RenderStats {
+    pub seconds: f64,
+    /// Samples per pixel completed (all pixels).
+    pub spp: u32,
+    pub samples: u64,
+    pub rays: u64,
+    pub rejected_samples: u64,
+}
+
+impl RenderStats {
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "seconds": self.seconds,
+            "spp": self.spp,
+            "samples": self.samples,
+            "samples_per_second": self.samples as f64 / self.seconds.max(1e-9),
+            "rays": self.rays,
+            "rays_per_second": self.rays as f64 / self.seconds.max(1e-9),
+            "rejected_samples": self.rejected_samples,
+        })
+    }
+}
+
+/// Radiance for one camera ray, dispatching on the integrator.
+#[inline]
+fn sample_li(scene: &Scene, sampler: &mut Sampler, ray: crate::math::Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
+    match scene.integrator.kind {
+        IntegratorKind::Path => path::li(scene, sampler, ray, stats),
+        _ => volpath::li(scene, sampler, ray, scene.sensor_medium, stats),
+    }
+}
+
+/// Refuse integrators that are parsed but not implemented yet (never render something else silently).
+pub fn check_renderable(scene: &Scene) -> Result<(), String> {
+    match scene.integrator.kind {
+        IntegratorKind::Path | IntegratorKind::Volpath => Ok(()),
+        other => Err(format!("integrator {:?} is recognised but not implemented yet (use path or volpath)", other)),
+    }
+}
+
+/// Render the scene. `cancel` stops early (Ctrl-C); the samples done so far are kept.
+pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> RenderOutput {
+    let film = &scene.sensor.film;
+    let (cw, ch) = film.crop_size;
+    let (cx, cy) = film.crop_offset;
+    let rgba = matches!(film.pixel_format, PixelFormat::Rgba);
+    let moment = scene.integrator.moment;
+    // Channels: RGB, [A], [second moment of RGB].
+    let mut channels: Vec<String> = vec!["R".into(), "G".into(), "B".into()];
+    if rgba {
+        channels.push("A".into());
+    }
+    if moment {
+        for c in ["R", "G", "B"] {
+            channels.push(format!("m2.{}", c));
+        }
+    }
+    let nch = channels.len();
+    let total_spp = match (opts.spp, opts.time_budget) {
+        (Some(s), _) => s,
+        (None, Some(_)) => u32::MAX,
+        (None, None) => scene.sensor.sampler.sample_count,
+    };
+
+    let mut tiles = Vec::new();
+    for ty in (0..ch).step_by(TILE as usize) {
+        for tx in (0..cw).step_by(TILE as usize) {
+            tiles.push((cx + tx, cy + ty, TILE.min(cw - tx), TILE.min(ch - ty)));
+        }
+    }
+    let full = Mutex::new(ImageBlock::new((cx as i32, cy as i32), (cw, ch), film.filter, nch));
+    let stats = Stats::default();
+    let start = Instant::now();
+    let pixels = cw as u64 * ch as u64;
+    let bar = if opts.progress {
+        let len = if total_spp == u32::MAX { 0 } else { total_spp as u64 * pixels };
+        let b = indicatif::ProgressBar::new(len);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}% ({eta} left) {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+
+    let mut spp_done = 0u32;
+    let mut pass = 0u64;
+    let mut samples_done = 0u64;
+    while spp_done < total_spp && !cancel.load(Ordering::Relaxed) {
+        if let Some(t) = opts.time_budget {
+            if spp_done > 0 && start.elapsed().as_secs_f64() >= t {
+                break;
+            }
+        }
+        // Passes double in size (1, 2, 4, ... 64 spp) so a time budget is met closely.
+        let pass_spp = (1u32 << pass.min(6)).min(total_spp - spp_done);
+        let first_sample = spp_done;
+        let completed = std::sync::atomic::AtomicU64::new(0);
+        tiles.par_iter().for_each(|&(x0, y0, w, h)| {
+            if cancel.load(Ordering::Relaxed) {
+                return;
+            }
+            let mut block = ImageBlock::new((x0 as i32, y0 as i32), (w, h), film.filter, nch);
+            let mut local = LocalStats::default();
+            let mut values = vec![0.0f32; nch];
+            for y in y0..y0 + h {
+                for x in x0..x0 + w {
+                    let pixel_index = y as u64 * film.width as u64 + x as u64;
+                    let mut sampler = Sampler::new(opts.seed, pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(first_sample as u64));
+                    for _ in 0..pass_spp {
+                        let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                        let aperture = sampler.next_2d();
+                        let ray = scene.sensor.camera.sample_ray(pos, aperture);
+                        let (mut l, valid) = sample_li(scene, &mut sampler, ray, &mut local);
+                        if !l.is_finite() {
+                            local.rejected_samples += 1;
+                            l = Spectrum::ZERO;
+                        }
+                        values[..3].copy_from_slice(&l.to_array());
+                        let mut k = 3;
+                        if rgba {
+                            values[3] = if valid { 1.0 } else { 0.0 };
+                            k = 4;
+                        }
+                        if moment {
+                            values[k..k + 3].copy_from_slice(&(l * l).to_array());
+                        }
+                        block.put(pos, &values);
+                    }
+                }
+            }
+            stats.add(&local);
+            if let Ok(mut f) = full.lock() {
+                f.merge(&block);
+            }
+            let n = w as u64 * h as u64 * pass_spp as u64;
+            completed.fetch_add(n, Ordering::Relaxed);
+            bar.inc(n);
+        });
+        samples_done += completed.load(Ordering::Relaxed);
+        if cancel.load(Ordering::Relaxed) {
+            break;
+        }
+        spp_done += pass_spp;
+        pass += 1;
+        if total_spp == u32::MAX {
+            bar.set_message(format!("{} spp", spp_done));
+        }
+    }
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    let data = full.into_inner().map(|f| f.develop()).unwrap_or_default();
+    RenderOutput {
+        width: cw as usize,
+        height: ch as usize,
+        channels,
+        data,
+        stats: RenderStats {
+            seconds,
+            spp: spp_done,
+            samples: samples_done,
+            rays: stats.rays.load(Ordering::Relaxed),
+            rejected_samples: stats.rejected_samples.load(Ordering::Relaxed),
+        },
+    }
+}

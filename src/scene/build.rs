@@ -1,0 +1,322 @@
+//! Scene building: the `ObjectDesc` tree → [`Scene`] (meshes loaded and transformed, BVH built,
+//! BSDFs, emitters, media, sensor and integrator instantiated). Objects referenced twice
+//! (`<ref>`) are built once and shared by index.
+
+use super::desc::{ObjectDesc, PluginKind};
+use super::resolver::FileResolver;
+use super::world::{Scene, SceneEmitter};
+use super::xml::ParsedScene;
+use super::{Error, Result};
+use crate::bsdf::Bsdf;
+use crate::emitter::Emitter;
+use crate::integrator::IntegratorDesc;
+use crate::math::{Aabb, Mat4, Vec3};
+use crate::medium::Homogeneous;
+use crate::sensor::Sensor;
+use crate::shape::accel::Accel;
+use crate::shape::mesh::{cube_data, rectangle_data};
+use crate::shape::{mesh_data::MeshData, obj, ply, serialized, Disk, Geometry, Mesh, Shape, Sphere};
+use crate::texture::Texture;
+use std::collections::HashMap;
+use std::path::Path;
+use std::rc::Rc;
+
+/// Parse and build a scene file.
+pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<Scene> {
+    let parsed = super::xml::parse_file(path, defines)?;
+    build_scene(&parsed)
+}
+
+pub const SUPPORTED_SHAPES: &str = "obj, ply, serialized, rectangle, cube, sphere, disk";
+
+struct Builder<'a> {
+    resolver: &'a FileResolver,
+    shapes: Vec<Shape>,
+    bsdfs: Vec<Bsdf>,
+    bsdf_ids: HashMap<*const ObjectDesc, u32>,
+    media: Vec<Homogeneous>,
+    medium_ids: HashMap<*const ObjectDesc, u32>,
+    emitters: Vec<SceneEmitter>,
+    environment: Option<(u32, ObjectPos)>,
+    default_bsdf: Option<u32>,
+    null_bsdf: Option<u32>,
+}
+
+type ObjectPos = super::SrcPos;
+
+pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
+    let root = &parsed.root;
+    let mut b = Builder {
+        resolver: &parsed.resolver,
+        shapes: Vec::new(),
+        bsdfs: Vec::new(),
+        bsdf_ids: HashMap::new(),
+        media: Vec::new(),
+        medium_ids: HashMap::new(),
+        emitters: Vec::new(),
+        environment: None,
+        default_bsdf: None,
+        null_bsdf: None,
+    };
+    let mut integrator: Option<(IntegratorDesc, ObjectPos)> = None;
+    let mut sensor: Option<Sensor> = None;
+    let mut sensor_pos: Option<ObjectPos> = None;
+    for (_, obj) in root.props.objects() {
+        match obj.kind {
+            PluginKind::Integrator => {
+                if let Some((_, first)) = &integrator {
+                    return Err(Error::at(&obj.pos, format!("a scene has at most one integrator (the first is at {})", first)));
+                }
+                integrator = Some((IntegratorDesc::from_desc(&obj)?, obj.pos.clone()));
+            }
+            PluginKind::Sensor => {
+                if let Some(first) = &sensor_pos {
+                    return Err(Error::at(&obj.pos, format!("only one sensor is supported (the first is at {})", first)));
+                }
+                if obj.plugin != "perspective" {
+                    return Err(Error::at(
+                        &obj.pos,
+                        format!("sensor \"{}\" is not supported at the top level (supported: perspective)", obj.plugin),
+                    ));
+                }
+                sensor = Some(Sensor::from_desc(&obj, b.resolver)?);
+                sensor_pos = Some(obj.pos.clone());
+            }
+            PluginKind::Shape => b.shape(&obj)?,
+            PluginKind::Emitter => b.emitter(&obj)?,
+            PluginKind::Bsdf => {
+                b.bsdf(&obj)?;
+            }
+            PluginKind::Medium => {
+                b.medium(&obj)?;
+            }
+            PluginKind::Texture => {
+                Texture::from_arg(&super::desc::TexArg::Texture(obj.clone()), b.resolver)?;
+            }
+            PluginKind::Phase => {
+                crate::medium::Phase::from_desc(&obj)?;
+            }
+            PluginKind::Film | PluginKind::RFilter | PluginKind::Sampler | PluginKind::Scene => {
+                return Err(Error::at(
+                    &obj.pos,
+                    format!("a <{}> must be nested in a <sensor> (or film), not in the scene", obj.kind.tag()),
+                ));
+            }
+        }
+    }
+    root.props.finish()?;
+    let Some(mut sensor) = sensor else {
+        return Err(Error::at(&root.pos, "the scene has no <sensor> (a perspective camera is needed to render)"));
+    };
+    let sensor_medium = match sensor.medium_ref.take() {
+        Some(m) => Some(b.medium(&m)?),
+        None => None,
+    };
+    let integrator = integrator.map(|i| i.0).unwrap_or_default();
+
+    let mut bounds = Aabb::EMPTY;
+    for s in &b.shapes {
+        bounds = bounds.union(&s.bounds());
+    }
+    let (center, radius) = if bounds.is_empty() {
+        (Vec3::ZERO, 1.0)
+    } else {
+        let c = bounds.center();
+        (c, ((bounds.max - c).length() * (1.0 + crate::interaction::RAY_EPSILON)).max(crate::interaction::RAY_EPSILON))
+    };
+    for e in &mut b.emitters {
+        if let SceneEmitter::Other(e) = e {
+            e.set_scene_bounds(center, radius);
+        }
+    }
+    let accel = Accel::build(&b.shapes);
+    Ok(Scene {
+        accel,
+        shapes: b.shapes,
+        bsdfs: b.bsdfs,
+        emitters: b.emitters,
+        environment: b.environment.map(|e| e.0),
+        media: b.media,
+        sensor,
+        sensor_medium,
+        integrator,
+        bounds,
+    })
+}
+
+impl Builder<'_> {
+    fn bsdf(&mut self, obj: &Rc<ObjectDesc>) -> Result<u32> {
+        let key = Rc::as_ptr(obj);
+        if let Some(&i) = self.bsdf_ids.get(&key) {
+            return Ok(i);
+        }
+        let bsdf = Bsdf::from_desc(obj, self.resolver)?;
+        self.bsdfs.push(bsdf);
+        let i = (self.bsdfs.len() - 1) as u32;
+        self.bsdf_ids.insert(key, i);
+        Ok(i)
+    }
+
+    fn medium(&mut self, obj: &Rc<ObjectDesc>) -> Result<u32> {
+        let key = Rc::as_ptr(obj);
+        if let Some(&i) = self.medium_ids.get(&key) {
+            return Ok(i);
+        }
+        if obj.kind != PluginKind::Medium {
+            return Err(Error::at(&obj.pos, format!("expected a <medium>, found a <{}>", obj.kind.tag())));
+        }
+        let m = Homogeneous::from_desc(obj)?;
+        self.media.push(m);
+        let i = (self.media.len() - 1) as u32;
+        self.medium_ids.insert(key, i);
+        Ok(i)
+    }
+
+    /// Mitsuba's default BSDF for a shape without one: diffuse (0.5), or null on a medium boundary.
+    fn default_bsdf(&mut self, null: bool) -> Result<u32> {
+        let slot = if null { self.null_bsdf } else { self.default_bsdf };
+        if let Some(i) = slot {
+            return Ok(i);
+        }
+        let bsdf = if null {
+            Bsdf::Null
+        } else {
+            let pos = super::SrcPos::new("<default bsdf>", 0, 0);
+            let obj = ObjectDesc {
+                kind: PluginKind::Bsdf,
+                plugin: "diffuse".into(),
+                id: None,
+                pos: pos.clone(),
+                props: super::desc::Props::new(PluginKind::Bsdf, "diffuse", pos),
+            };
+            Bsdf::from_desc(&obj, self.resolver)?
+        };
+        self.bsdfs.push(bsdf);
+        let i = (self.bsdfs.len() - 1) as u32;
+        if null {
+            self.null_bsdf = Some(i);
+        } else {
+            self.default_bsdf = Some(i);
+        }
+        Ok(i)
+    }
+
+    fn emitter(&mut self, obj: &Rc<ObjectDesc>) -> Result<()> {
+        if obj.plugin == "area" {
+            return Err(Error::at(&obj.pos, "an area emitter must be nested inside a <shape>"));
+        }
+        let e = Emitter::from_desc(obj, self.resolver)?;
+        let env = e.is_environment();
+        self.emitters.push(SceneEmitter::Other(e));
+        if env {
+            if let Some((_, first)) = &self.environment {
+                return Err(Error::at(
+                    &obj.pos,
+                    format!("a scene has at most one environment emitter (the first is at {})", first),
+                ));
+            }
+            self.environment = Some(((self.emitters.len() - 1) as u32, obj.pos.clone()));
+        }
+        Ok(())
+    }
+
+    fn shape(&mut self, obj: &Rc<ObjectDesc>) -> Result<()> {
+        let props = &obj.props;
+        let to_world = props.transform("to_world")?;
+        if !to_world.is_finite() || to_world.determinant() == 0.0 {
+            return Err(props.error("to_world", "to_world is singular or not finite"));
+        }
+        let flip_normals = props.bool("flip_normals", false)?;
+        let mesh = |data: MeshData, face_normals: bool| Geometry::Mesh(Mesh::new(data, &to_world, face_normals, flip_normals));
+        let geometry = match obj.plugin.as_str() {
+            "obj" | "ply" | "serialized" => {
+                let Some(name) = props.string_opt("filename")? else {
+                    return Err(Error::at(&obj.pos, format!("shape \"{}\" requires a \"filename\"", obj.plugin)));
+                };
+                let path = self.resolver.resolve_at(&name, &props.pos_of("filename"))?;
+                let face_normals = props.bool("face_normals", false)?;
+                let mut data = match obj.plugin.as_str() {
+                    "obj" => obj::load_obj(&path)?,
+                    "ply" => ply::load_ply(&path)?,
+                    _ => {
+                        let index = props.int("shape_index", 0)?;
+                        if index < 0 || index > u32::MAX as i64 {
+                            return Err(props.error("shape_index", "shape_index must be non-negative"));
+                        }
+                        serialized::load_serialized(&path, index as u32)?
+                    }
+                };
+                if obj.plugin == "obj" && props.bool("flip_tex_coords", true)? {
+                    for uv in &mut data.uvs {
+                        uv.y = 1.0 - uv.y;
+                    }
+                }
+                mesh(data, face_normals)
+            }
+            "rectangle" => mesh(rectangle_data(), false),
+            "cube" => mesh(cube_data(), false),
+            "sphere" => {
+                let center = props.point("center", Vec3::ZERO)?;
+                let radius = props.float("radius", 1.0)?;
+                if !(radius > 0.0 && radius.is_finite()) {
+                    return Err(props.error("radius", "sphere radius must be positive"));
+                }
+                let sx = to_world.transform_vector3(Vec3::X).length();
+                let sy = to_world.transform_vector3(Vec3::Y).length();
+                let sz = to_world.transform_vector3(Vec3::Z).length();
+                if (sx - sy).abs() > 1e-4 * sx || (sx - sz).abs() > 1e-4 * sx {
+                    return Err(props.error("to_world", "sphere: to_world must not contain a non-uniform scale"));
+                }
+                Geometry::Sphere(Sphere {
+                    center: to_world.transform_point3(center),
+                    radius: radius * sx,
+                    flip_normals,
+                })
+            }
+            "disk" => Geometry::Disk(Disk::new(to_world, flip_normals)),
+            other => {
+                return Err(Error::at(
+                    &obj.pos,
+                    format!("shape \"{}\" is not supported (supported: {})", other, SUPPORTED_SHAPES),
+                ))
+            }
+        };
+        let index = self.shapes.len() as u32;
+        let interior = match props.object_named("interior", PluginKind::Medium)? {
+            Some(m) => Some(self.medium(&m)?),
+            None => None,
+        };
+        let exterior = match props.object_named("exterior", PluginKind::Medium)? {
+            Some(m) => Some(self.medium(&m)?),
+            None => None,
+        };
+        let bsdf = match props.object_of(PluginKind::Bsdf)? {
+            Some(b) => self.bsdf(&b)?,
+            None => self.default_bsdf(interior.is_some() || exterior.is_some())?,
+        };
+        let mut emitter = None;
+        if let Some(e) = props.object_of(PluginKind::Emitter)? {
+            if e.plugin != "area" {
+                return Err(Error::at(
+                    &e.pos,
+                    format!("emitter \"{}\" cannot be attached to a shape (only \"area\" can)", e.plugin),
+                ));
+            }
+            let ep = &e.props;
+            let Some(arg) = ep.texture_opt("radiance")? else {
+                return Err(Error::at(&e.pos, "area emitter requires a \"radiance\""));
+            };
+            let radiance = Texture::from_arg(&arg, self.resolver)?;
+            ep.finish()?;
+            self.emitters.push(SceneEmitter::Area { shape: index, radiance });
+            emitter = Some((self.emitters.len() - 1) as u32);
+        }
+        if let Some(s) = props.object_of(PluginKind::Sensor)? {
+            return Err(Error::at(&s.pos, format!("sensor \"{}\" inside a shape is not supported yet", s.plugin)));
+        }
+        props.finish()?;
+        self.shapes.push(Shape { geometry, plugin: obj.plugin.clone(), id: obj.id.clone(), bsdf, emitter, interior, exterior });
+        Ok(())
+    }
+}
+

@@ -1,0 +1,176 @@
+//! The built scene: shapes with their BVH, BSDFs, emitters, media, the sensor and the integrator
+//! settings; ray queries and emitter sampling (Mitsuba's `Scene`).
+
+use crate::bsdf::Bsdf;
+use crate::color::Spectrum;
+use crate::emitter::Emitter;
+use crate::integrator::IntegratorDesc;
+use crate::interaction::{DirectionSample, SurfaceInteraction};
+use crate::math::{Aabb, Ray, Vec2, Vec3};
+use crate::medium::Homogeneous;
+use crate::sensor::Sensor;
+use crate::shape::accel::Accel;
+use crate::shape::Shape;
+use crate::texture::Texture;
+
+/// An emitter of the scene: an area light bound to a shape, or a standalone emitter.
+#[derive(Clone, Debug)]
+pub enum SceneEmitter {
+    /// Mitsuba's `area` emitter: emits `radiance` from the front side of shape `shape`.
+    Area { shape: u32, radiance: Texture },
+    Other(Emitter),
+}
+
+pub struct Scene {
+    pub shapes: Vec<Shape>,
+    pub accel: Accel,
+    pub bsdfs: Vec<Bsdf>,
+    pub emitters: Vec<SceneEmitter>,
+    /// Index of the environment emitter (envmap or constant), if any.
+    pub environment: Option<u32>,
+    pub media: Vec<Homogeneous>,
+    pub sensor: Sensor,
+    /// Medium the camera sits in.
+    pub sensor_medium: Option<u32>,
+    pub integrator: IntegratorDesc,
+    pub bounds: Aabb,
+}
+
+impl Scene {
+    /// Closest surface hit.
+    #[inline]
+    pub fn ray_intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+        let hit = self.accel.intersect(&self.shapes, ray)?;
+        let mut si = self.shapes[hit.shape as usize].interaction(hit.prim, hit.b1, hit.b2, hit.t, ray);
+        si.shape = hit.shape;
+        Some(si)
+    }
+
+    /// True when the segment is blocked.
+    #[inline]
+    pub fn ray_test(&self, ray: &Ray) -> bool {
+        self.accel.occluded(&self.shapes, ray)
+    }
+
+    /// The BSDF of the shape that was hit.
+    #[inline]
+    pub fn bsdf(&self, si: &SurfaceInteraction) -> &Bsdf {
+        &self.bsdfs[self.shapes[si.shape as usize].bsdf as usize]
+    }
+
+    /// Emitter selection probability (uniform, as Mitsuba's `sample_emitter`).
+    #[inline]
+    pub fn emitter_selection_pdf(&self) -> f32 {
+        1.0 / self.emitters.len() as f32
+    }
+
+    /// Pick an emitter uniformly and sample a direction towards it from `ref_p`.
+    /// Returns (ds, weight) where weight = L·(geometry)/pdf including the selection probability;
+    /// zero weight when the sample failed or (with `test_visibility`) is occluded.
+    pub fn sample_emitter_direction(&self, ref_p: Vec3, ref_n: Option<Vec3>, sample: Vec2, test_visibility: bool) -> (DirectionSample, Spectrum) {
+        let n = self.emitters.len();
+        if n == 0 {
+            return (DirectionSample::default(), Spectrum::ZERO);
+        }
+        let x = sample.x * n as f32;
+        let index = (x as usize).min(n - 1);
+        let sample = Vec2::new(x - index as f32, sample.y);
+        let (mut ds, mut weight) = self.sample_one_emitter(index, ref_p, sample);
+        ds.emitter = index as u32;
+        ds.pdf /= n as f32;
+        weight *= n as f32;
+        if ds.pdf <= 0.0 || !crate::color::is_finite(weight) {
+            return (ds, Spectrum::ZERO);
+        }
+        if test_visibility {
+            let o = match ref_n {
+                Some(nrm) => crate::interaction::offset_origin(ref_p, nrm, ds.d),
+                None => ref_p,
+            };
+            let ray = if ds.dist.is_finite() {
+                crate::interaction::spawn_ray_between(o, ds.p)
+            } else {
+                Ray::new(o, ds.d)
+            };
+            if self.ray_test(&ray) {
+                return (ds, Spectrum::ZERO);
+            }
+        }
+        (ds, weight)
+    }
+
+    fn sample_one_emitter(&self, index: usize, ref_p: Vec3, sample: Vec2) -> (DirectionSample, Spectrum) {
+        match &self.emitters[index] {
+            SceneEmitter::Other(e) => e.sample_direction(ref_p, sample),
+            SceneEmitter::Area { shape, radiance } => {
+                let ds = self.shapes[*shape as usize].sample_direction(ref_p, sample);
+                // Emission only from the front side (Mitsuba's area emitter is one-sided).
+                if ds.pdf > 0.0 && ds.d.dot(ds.n) < 0.0 {
+                    let w = radiance.eval(ds.uv) / ds.pdf;
+                    (ds, w)
+                } else {
+                    (DirectionSample { pdf: 0.0, ..ds }, Spectrum::ZERO)
+                }
+            }
+        }
+    }
+
+    /// Solid-angle density (including selection) of sampling `ds` from `ref_p`.
+    pub fn pdf_emitter_direction(&self, ref_p: Vec3, ds: &DirectionSample) -> f32 {
+        let sel = self.emitter_selection_pdf();
+        match &self.emitters[ds.emitter as usize] {
+            SceneEmitter::Other(e) => e.pdf_direction(ref_p, ds) * sel,
+            SceneEmitter::Area { shape, .. } => {
+                if ds.d.dot(ds.n) >= 0.0 {
+                    return 0.0;
+                }
+                self.shapes[*shape as usize].pdf_direction(ref_p, ds) * sel
+            }
+        }
+    }
+
+    /// Radiance leaving an emitting surface towards the previous vertex (`si.wi`).
+    pub fn eval_area_emitter(&self, si: &SurfaceInteraction) -> Spectrum {
+        let Some(e) = self.shapes[si.shape as usize].emitter else { return Spectrum::ZERO };
+        match &self.emitters[e as usize] {
+            SceneEmitter::Area { radiance, .. } if si.wi.z > 0.0 => radiance.eval(si.uv),
+            _ => Spectrum::ZERO,
+        }
+    }
+
+    /// A direction sample record for an emitter that was hit by a ray from `ref_p` (for MIS pdfs).
+    pub fn direction_sample_for_hit(&self, ref_p: Vec3, si: &SurfaceInteraction) -> DirectionSample {
+        let d = si.p - ref_p;
+        let dist = d.length();
+        DirectionSample {
+            p: si.p,
+            n: si.n,
+            uv: si.uv,
+            d: d / dist,
+            dist,
+            pdf: 0.0,
+            delta: false,
+            emitter: self.shapes[si.shape as usize].emitter.unwrap_or(0),
+        }
+    }
+
+    /// A direction sample record for the environment seen along `d` (for MIS pdfs).
+    pub fn environment_direction_sample(&self, env: u32, d: Vec3) -> DirectionSample {
+        DirectionSample { d, dist: f32::INFINITY, emitter: env, ..Default::default() }
+    }
+
+    /// Radiance from the environment along an escaping ray direction.
+    pub fn eval_environment(&self, d: Vec3) -> Spectrum {
+        match self.environment {
+            Some(i) => match &self.emitters[i as usize] {
+                SceneEmitter::Other(e) => e.eval_environment(d),
+                _ => Spectrum::ZERO,
+            },
+            None => Spectrum::ZERO,
+        }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.shapes.iter().map(|s| s.triangle_count()).sum()
+    }
+}

@@ -1,0 +1,181 @@
+//! World-space triangle mesh: vertex data after `to_world`, area-weighted sampling, and the
+//! surface interaction of a hit (geometric normal from the winding, interpolated shading normal).
+//!
+//! Without vertex normals in the file (and with `face_normals = false`), vertex normals are
+//! recomputed by angle weighting as Mitsuba's `Mesh::recompute_vertex_normals` does.
+
+use super::mesh_data::MeshData;
+use crate::interaction::{PositionSample, SurfaceInteraction};
+use crate::math::{warp, Aabb, Frame, Mat4, Vec2, Vec3};
+
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    /// One per vertex, or empty when `face_normals` is set.
+    pub normals: Vec<Vec3>,
+    /// One per vertex, or empty (then uv = barycentrics (b1, b2) as in Mitsuba).
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<[u32; 3]>,
+    pub flip_normals: bool,
+    /// Cumulative triangle areas (for area sampling); last entry = total area.
+    area_cdf: Vec<f32>,
+}
+
+impl Mesh {
+    /// Transform loaded data into world space. `face_normals` drops vertex normals.
+    pub fn new(data: MeshData, to_world: &Mat4, face_normals: bool, flip_normals: bool) -> Mesh {
+        let positions: Vec<Vec3> = data.positions.iter().map(|p| to_world.transform_point3(*p)).collect();
+        let normals = if face_normals {
+            Vec::new()
+        } else if data.normals.is_empty() {
+            recompute_vertex_normals(&positions, &data.indices)
+        } else {
+            let inv_t = to_world.inverse().transpose();
+            data.normals
+                .iter()
+                .map(|n| {
+                    let m = inv_t.transform_vector3(*n);
+                    let l = m.length();
+                    if l > 0.0 {
+                        m / l
+                    } else {
+                        m
+                    }
+                })
+                .collect()
+        };
+        let mut area_cdf = Vec::with_capacity(data.indices.len());
+        let mut total = 0.0f64;
+        for idx in &data.indices {
+            let [a, b, c] = idx.map(|i| positions[i as usize]);
+            total += 0.5 * (b - a).cross(c - a).length() as f64;
+            area_cdf.push(total as f32);
+        }
+        Mesh { positions, normals, uvs: data.uvs, indices: data.indices, flip_normals, area_cdf }
+    }
+
+    pub fn surface_area(&self) -> f32 {
+        self.area_cdf.last().copied().unwrap_or(0.0)
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len()
+    }
+
+    #[inline]
+    pub fn vertices(&self, prim: u32) -> [Vec3; 3] {
+        self.indices[prim as usize].map(|i| self.positions[i as usize])
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for p in &self.positions {
+            b.expand(*p);
+        }
+        b
+    }
+
+    /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
+    pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
+        let idx = self.indices[prim as usize];
+        let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
+        let b0 = 1.0 - b1 - b2;
+        let p = p0 * b0 + p1 * b1 + p2 * b2;
+        let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        let uv = if self.uvs.is_empty() {
+            Vec2::new(b1, b2)
+        } else {
+            let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
+            u0 * b0 + u1 * b1 + u2 * b2
+        };
+        let mut sh_n = if self.normals.is_empty() {
+            n
+        } else {
+            let [n0, n1, n2] = idx.map(|i| self.normals[i as usize]);
+            (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero()
+        };
+        if sh_n == Vec3::ZERO {
+            sh_n = n;
+        }
+        if self.flip_normals {
+            n = -n;
+            sh_n = -sh_n;
+        }
+        let sh_frame = Frame::from_normal(sh_n);
+        SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray_d), shape: 0, prim }
+    }
+
+    /// Uniform by area: pick a triangle by area, then a uniform point on it.
+    pub fn sample_position(&self, sample: Vec2) -> PositionSample {
+        let total = self.surface_area();
+        let target = sample.x * total;
+        let prim = self.area_cdf.partition_point(|&c| c <= target).min(self.indices.len().saturating_sub(1));
+        let lo = if prim == 0 { 0.0 } else { self.area_cdf[prim - 1] };
+        let area = self.area_cdf[prim] - lo;
+        let sx = if area > 0.0 { ((target - lo) / area).clamp(0.0, 1.0 - f32::EPSILON) } else { 0.5 };
+        let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
+        let si = self.interaction(prim as u32, b.x, b.y, 0.0, Vec3::Z);
+        PositionSample { p: si.p, n: si.n, uv: si.uv, pdf: 1.0 / total }
+    }
+}
+
+/// Angle-weighted vertex normals (Mitsuba's `recompute_vertex_normals`).
+pub fn recompute_vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for idx in indices {
+        let v = idx.map(|i| positions[i as usize]);
+        let face_n = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+        if face_n == Vec3::ZERO {
+            continue;
+        }
+        for k in 0..3 {
+            let d0 = (v[(k + 1) % 3] - v[k]).normalize_or_zero();
+            let d1 = (v[(k + 2) % 3] - v[k]).normalize_or_zero();
+            let angle = d0.dot(d1).clamp(-1.0, 1.0).acos();
+            if angle.is_finite() {
+                normals[idx[k] as usize] += face_n * angle;
+            }
+        }
+    }
+    for n in &mut normals {
+        let l = n.length();
+        *n = if l > 0.0 { *n / l } else { Vec3::Z };
+    }
+    normals
+}
+
+/// Mitsuba's `rectangle`: [-1,1]² in the local XY plane, normal +Z, uv = ((x+1)/2, (y+1)/2).
+pub fn rectangle_data() -> MeshData {
+    MeshData {
+        positions: vec![Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0), Vec3::new(1.0, 1.0, 0.0)],
+        normals: vec![Vec3::Z; 4],
+        uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)],
+        indices: vec![[1, 2, 0], [1, 3, 2]],
+    }
+}
+
+/// Mitsuba's `cube`: [-1,1]³, 24 vertices with per-face normals and uvs (data read from Mitsuba 3.9).
+pub fn cube_data() -> MeshData {
+    const P: [[f32; 3]; 24] = [
+        [1., -1., -1.], [1., -1., 1.], [-1., -1., 1.], [-1., -1., -1.],
+        [1., 1., -1.], [-1., 1., -1.], [-1., 1., 1.], [1., 1., 1.],
+        [1., -1., -1.], [1., 1., -1.], [1., 1., 1.], [1., -1., 1.],
+        [1., -1., 1.], [1., 1., 1.], [-1., 1., 1.], [-1., -1., 1.],
+        [-1., -1., 1.], [-1., 1., 1.], [-1., 1., -1.], [-1., -1., -1.],
+        [1., 1., -1.], [1., -1., -1.], [-1., -1., -1.], [-1., 1., -1.],
+    ];
+    const N: [[f32; 3]; 6] = [[0., -1., 0.], [0., 1., 0.], [1., 0., 0.], [0., 0., 1.], [-1., 0., 0.], [0., 0., -1.]];
+    const UV: [[f32; 2]; 4] = [[0., 1.], [1., 1.], [1., 0.], [0., 0.]];
+    let mut d = MeshData::default();
+    for (i, p) in P.iter().enumerate() {
+        d.positions.push(Vec3::from_array(*p));
+        d.normals.push(Vec3::from_array(N[i / 4]));
+        d.uvs.push(Vec2::from_array(UV[i % 4]));
+    }
+    for f in 0..6u32 {
+        let b = 4 * f;
+        d.indices.push([b, b + 1, b + 2]);
+        d.indices.push([b + 3, b, b + 2]);
+    }
+    d
+}

@@ -1,0 +1,151 @@
+//! Mitsuba's analytic `sphere`: `center` (0,0,0), `radius` 1, `to_world` (uniform scale), `flip_normals`.
+//!
+//! ```xml
+//! <shape type="sphere"><point name="center" value="0, 1, 0"/><float name="radius" value="0.5"/></shape>
+//! ```
+//! Seen from outside, emitters on it are sampled by the cone of directions it subtends (uniform in
+//! solid angle), as Mitsuba does; from inside, by area.
+
+use crate::interaction::{DirectionSample, PositionSample, SurfaceInteraction};
+use crate::math::{warp, Aabb, Frame, Ray, Vec2, Vec3, INV_PI, INV_TWO_PI, PI};
+
+#[derive(Clone, Debug)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub flip_normals: bool,
+}
+
+impl Sphere {
+    pub fn bounds(&self) -> Aabb {
+        Aabb { min: self.center - Vec3::splat(self.radius), max: self.center + Vec3::splat(self.radius) }
+    }
+
+    pub fn surface_area(&self) -> f32 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    /// Nearest intersection distance in (0, tmax), in double precision for robustness.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<f32> {
+        let o = (ray.o - self.center).as_dvec3();
+        let d = ray.d.as_dvec3();
+        let r = self.radius as f64;
+        let a = d.length_squared();
+        let b = 2.0 * o.dot(d);
+        let c = o.length_squared() - r * r;
+        let disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            return None;
+        }
+        let sq = disc.sqrt();
+        // Numerically stable roots.
+        let q = if b < 0.0 { -0.5 * (b - sq) } else { -0.5 * (b + sq) };
+        let (mut t0, mut t1) = (q / a, c / q);
+        if t0 > t1 {
+            std::mem::swap(&mut t0, &mut t1);
+        }
+        let tmax = ray.tmax as f64;
+        if t0 > 0.0 && t0 < tmax {
+            Some(t0 as f32)
+        } else if t1 > 0.0 && t1 < tmax {
+            Some(t1 as f32)
+        } else {
+            None
+        }
+    }
+
+    fn local_uv(&self, p: Vec3) -> Vec2 {
+        let l = (p - self.center) / self.radius;
+        let theta = l.z.clamp(-1.0, 1.0).acos();
+        let mut phi = l.y.atan2(l.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        Vec2::new(phi * INV_TWO_PI, theta * INV_PI)
+    }
+
+    pub fn interaction(&self, t: f32, ray: &Ray) -> SurfaceInteraction {
+        let hit = ray.at(t);
+        let mut n = (hit - self.center).normalize();
+        // Re-project onto the surface to reduce error (as Mitsuba does).
+        let p = self.center + n * self.radius;
+        let uv = self.local_uv(p);
+        if self.flip_normals {
+            n = -n;
+        }
+        let sh_frame = Frame::from_normal(n);
+        SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray.d), shape: 0, prim: 0 }
+    }
+
+    pub fn sample_position(&self, sample: Vec2) -> PositionSample {
+        let d = warp::square_to_uniform_sphere(sample);
+        let p = self.center + d * self.radius;
+        PositionSample { p, n: if self.flip_normals { -d } else { d }, uv: self.local_uv(p), pdf: 1.0 / self.surface_area() }
+    }
+
+    /// Sample a point visible from `ref_p` (Mitsuba's `Sphere::sample_direction`).
+    pub fn sample_direction(&self, ref_p: Vec3, sample: Vec2) -> DirectionSample {
+        let dc = self.center - ref_p;
+        let dist2 = dc.length_squared();
+        let r2 = self.radius * self.radius;
+        if dist2 > r2 * (1.0 + 1e-4) {
+            // Outside: uniform in the subtended cone.
+            let inv_dc = 1.0 / dist2.sqrt();
+            let sin_alpha = self.radius * inv_dc;
+            let cos_alpha = (1.0 - sin_alpha * sin_alpha).max(0.0).sqrt();
+            let frame = Frame::from_normal(dc * inv_dc);
+            let local = warp::square_to_uniform_cone(sample, cos_alpha);
+            let d = frame.to_world(local);
+            // Intersect the ray with the sphere to find the point.
+            let ray = Ray::new(ref_p, d);
+            let t = self.intersect(&ray).unwrap_or_else(|| {
+                // Grazing: closest point on the ray to the centre.
+                dc.dot(d).max(0.0)
+            });
+            let p = ref_p + d * t;
+            let mut n = (p - self.center).normalize_or_zero();
+            if self.flip_normals {
+                n = -n;
+            }
+            let pdf = warp::square_to_uniform_cone_pdf(local, cos_alpha);
+            DirectionSample { p, n, uv: self.local_uv(p), d, dist: t, pdf, delta: false, emitter: 0 }
+        } else {
+            let ps = self.sample_position(sample);
+            area_to_direction_sample(ref_p, ps)
+        }
+    }
+
+    pub fn pdf_direction(&self, ref_p: Vec3, ds: &DirectionSample) -> f32 {
+        let dc = self.center - ref_p;
+        let dist2 = dc.length_squared();
+        let r2 = self.radius * self.radius;
+        if dist2 > r2 * (1.0 + 1e-4) {
+            let sin_alpha = self.radius / dist2.sqrt();
+            let cos_alpha = (1.0 - sin_alpha * sin_alpha).max(0.0).sqrt();
+            INV_TWO_PI / (1.0 - cos_alpha)
+        } else {
+            area_pdf_to_solid_angle(1.0 / self.surface_area(), ds.dist, ds.d, ds.n)
+        }
+    }
+}
+
+/// Convert an area sample seen from `ref_p` to a direction sample with a solid-angle pdf.
+pub fn area_to_direction_sample(ref_p: Vec3, ps: PositionSample) -> DirectionSample {
+    let delta = ps.p - ref_p;
+    let dist = delta.length();
+    let d = if dist > 0.0 { delta / dist } else { Vec3::Z };
+    let pdf = area_pdf_to_solid_angle(ps.pdf, dist, d, ps.n);
+    DirectionSample { p: ps.p, n: ps.n, uv: ps.uv, d, dist, pdf, delta: false, emitter: 0 }
+}
+
+/// pdf_A · r² / |cos θ| (0 when the point is seen edge-on).
+#[inline]
+pub fn area_pdf_to_solid_angle(pdf_area: f32, dist: f32, d: Vec3, n: Vec3) -> f32 {
+    let cos = d.dot(n).abs();
+    if cos > 0.0 {
+        pdf_area * dist * dist / cos
+    } else {
+        0.0
+    }
+}

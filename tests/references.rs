@@ -1,0 +1,275 @@
+//! Reference regression: every `reference/NAME.exr` (rendered by Mitsuba 3 with
+//! `scripts/make_references.py`, channels R,G,B mean and var.R,var.G,var.B per-sample variance,
+//! spp in `reference/NAME.json`) is compared with our render of `scenes/NAME.xml`.
+//!
+//! Three statistical tests, each at family-wise level α = 0.01 with Šidák's correction:
+//! - per pixel: two-sample Z-test, our variance from the second-moment channel;
+//! - per 8×8 block: Welch-style t-test, our variance from independent batches (exact under the
+//!   pixel filter's correlations), the reference's from its variance channel;
+//! - the whole image (same batch method), which is what catches a ~1 % bias.
+//!
+//! On failure the render and a per-pixel z-score image are written to `target/test-output/`.
+
+use snee::compare::erfc;
+use snee::io::read::read_image;
+use snee::render::{render, RenderOptions};
+use snee::scene::build::load_scene;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+const ALPHA: f64 = 0.01;
+const BATCHES: usize = 16;
+const BLOCK: usize = 8;
+
+struct Image {
+    w: usize,
+    h: usize,
+    mean: Vec<[f64; 3]>,
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Student-t two-sided p-value with `dof` degrees of freedom (via the regularized incomplete beta).
+fn t_p_value(t: f64, dof: f64) -> f64 {
+    let x = dof / (dof + t * t);
+    incomplete_beta(0.5 * dof, 0.5, x)
+}
+
+fn ln_gamma(x: f64) -> f64 {
+    // Lanczos approximation (g = 7, n = 9).
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9, 676.520_368_121_885_1, -1_259.139_216_722_402_8, 771.323_428_777_653_1,
+        -176.615_029_162_140_6, 12.507_343_278_686_905, -0.138_571_095_265_720_12, 9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    let x = x - 1.0;
+    let mut a = C[0];
+    let t = x + 7.5;
+    for (i, c) in C.iter().enumerate().skip(1) {
+        a += c / (x + i as f64);
+    }
+    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// Regularized incomplete beta I_x(a, b) (Numerical Recipes' continued fraction).
+fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let bt = (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
+    let cf = |a: f64, b: f64, x: f64| {
+        let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
+        let mut c = 1.0;
+        let mut d = 1.0 - qab * x / qap;
+        d = if d.abs() < 1e-300 { 1e-300 } else { d };
+        d = 1.0 / d;
+        let mut h = d;
+        for m in 1..300 {
+            let m = m as f64;
+            let m2 = 2.0 * m;
+            let aa = m * (b - m) * x / ((qam + m2) * (a + m2));
+            d = 1.0 + aa * d;
+            d = if d.abs() < 1e-300 { 1e-300 } else { d };
+            c = 1.0 + aa / c;
+            c = if c.abs() < 1e-300 { 1e-300 } else { c };
+            d = 1.0 / d;
+            h *= d * c;
+            let aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
+            d = 1.0 + aa * d;
+            d = if d.abs() < 1e-300 { 1e-300 } else { d };
+            c = 1.0 + aa / c;
+            c = if c.abs() < 1e-300 { 1e-300 } else { c };
+            d = 1.0 / d;
+            let del = d * c;
+            h *= del;
+            if (del - 1.0).abs() < 1e-12 {
+                break;
+            }
+        }
+        h
+    };
+    if x < (a + 1.0) / (a + b + 2.0) {
+        bt * cf(a, b, x) / a
+    } else {
+        1.0 - bt * cf(b, a, 1.0 - x) / b
+    }
+}
+
+fn sidak(alpha: f64, n: usize) -> f64 {
+    1.0 - (1.0 - alpha).powf(1.0 / n.max(1) as f64)
+}
+
+/// Render `scene` in `BATCHES` independent batches; returns (batch images, mean, per-pixel variance of the mean).
+fn render_batches(scene_path: &Path, spp_per_batch: u32) -> (Vec<Image>, Image, Vec<[f64; 3]>) {
+    let mut scene = load_scene(scene_path, &[]).unwrap_or_else(|e| panic!("{}", e));
+    scene.integrator.moment = true;
+    let cancel = AtomicBool::new(false);
+    let mut batches = Vec::new();
+    let mut m2_sum: Vec<[f64; 3]> = Vec::new();
+    for b in 0..BATCHES {
+        let opts = RenderOptions { spp: Some(spp_per_batch), seed: 1000 + b as u64, time_budget: None, progress: false };
+        let out = render(&scene, &opts, &cancel);
+        let n = out.channels.len();
+        let m2i = out.channels.iter().position(|c| c == "m2.R").expect("moment channels");
+        let mean: Vec<[f64; 3]> = out.data.chunks(n).map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]).collect();
+        let m2: Vec<[f64; 3]> =
+            out.data.chunks(n).map(|p| [p[m2i] as f64, p[m2i + 1] as f64, p[m2i + 2] as f64]).collect();
+        if m2_sum.is_empty() {
+            m2_sum = vec![[0.0; 3]; m2.len()];
+        }
+        for (s, v) in m2_sum.iter_mut().zip(&m2) {
+            for c in 0..3 {
+                s[c] += v[c] / BATCHES as f64;
+            }
+        }
+        batches.push(Image { w: out.width, h: out.height, mean });
+    }
+    let (w, h) = (batches[0].w, batches[0].h);
+    let mut mean = vec![[0.0f64; 3]; w * h];
+    for b in &batches {
+        for (m, v) in mean.iter_mut().zip(&b.mean) {
+            for c in 0..3 {
+                m[c] += v[c] / BATCHES as f64;
+            }
+        }
+    }
+    let total_spp = (spp_per_batch as usize * BATCHES) as f64;
+    let var: Vec<[f64; 3]> = mean
+        .iter()
+        .zip(&m2_sum)
+        .map(|(m, m2)| [0, 1, 2].map(|c| ((m2[c] - m[c] * m[c]).max(0.0)) / total_spp))
+        .collect();
+    (batches, Image { w, h, mean }, var)
+}
+
+fn write_failure(name: &str, img: &Image, z: &[[f64; 3]]) -> PathBuf {
+    let dir = root().join("target/test-output");
+    let _ = std::fs::create_dir_all(&dir);
+    let data: Vec<f32> = img.mean.iter().flat_map(|p| p.map(|v| v as f32)).collect();
+    let zd: Vec<f32> = z.iter().flat_map(|p| p.map(|v| v as f32)).collect();
+    let _ = snee::io::write::write_exr(&dir.join(format!("{}.exr", name)), img.w, img.h, &["R", "G", "B"], &data);
+    let _ = snee::io::write::write_exr(&dir.join(format!("{}_z.exr", name)), img.w, img.h, &["R", "G", "B"], &zd);
+    dir
+}
+
+fn check_scene(name: &str, spp_per_batch: u32) {
+    let ref_exr = root().join("reference").join(format!("{}.exr", name));
+    let ref_json = root().join("reference").join(format!("{}.json", name));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&ref_json).expect("reference json")).expect("valid json");
+    let spp_ref = meta["spp"].as_f64().expect("spp in reference json");
+    let r = read_image(&ref_exr, false).unwrap_or_else(|e| panic!("{}", e));
+    let ch = |n: &str| r.channel(n).unwrap_or_else(|| panic!("reference lacks channel {}", n));
+    let (ir, ig, ib) = (ch("R"), ch("G"), ch("B"));
+    let (vr, vg, vb) = (ch("var.R"), ch("var.G"), ch("var.B"));
+    let nc = r.channels.len();
+    let ref_mean: Vec<[f64; 3]> = r.data.chunks(nc).map(|p| [p[ir] as f64, p[ig] as f64, p[ib] as f64]).collect();
+    let ref_var: Vec<[f64; 3]> =
+        r.data.chunks(nc).map(|p| [p[vr] as f64 / spp_ref, p[vg] as f64 / spp_ref, p[vb] as f64 / spp_ref]).collect();
+
+    let (batches, ours, our_var) = render_batches(&root().join("scenes").join(format!("{}.xml", name)), spp_per_batch);
+    assert_eq!((ours.w, ours.h), (r.width, r.height), "{}: image size differs from the reference", name);
+    assert!(ours.mean.iter().all(|p| p.iter().all(|v| v.is_finite())), "{}: non-finite pixels", name);
+
+    // ---- Per-pixel Z-test ----
+    let n_pix = ours.mean.len();
+    let mut z = vec![[0.0f64; 3]; n_pix];
+    let mut min_p: f64 = 1.0;
+    let mut worst = String::new();
+    for i in 0..n_pix {
+        for c in 0..3 {
+            let var = our_var[i][c] + ref_var[i][c];
+            let d = ours.mean[i][c] - ref_mean[i][c];
+            let p = if var > 0.0 {
+                z[i][c] = d / var.sqrt();
+                erfc(z[i][c].abs() / std::f64::consts::SQRT_2)
+            } else if d.abs() > 1e-5 * ref_mean[i][c].abs() + 1e-6 {
+                z[i][c] = f64::INFINITY;
+                0.0
+            } else {
+                1.0
+            };
+            if p < min_p {
+                min_p = p;
+                worst = format!("pixel ({}, {}) channel {}: ours {} ref {} z {:.2}", i % ours.w, i / ours.w, c, ours.mean[i][c], ref_mean[i][c], z[i][c]);
+            }
+        }
+    }
+    let level = sidak(ALPHA, n_pix * 3);
+
+    // ---- Block and whole-image tests (variance from batches) ----
+    let bw = ours.w.div_ceil(BLOCK);
+    let bh = ours.h.div_ceil(BLOCK);
+    let mut regions: Vec<Vec<usize>> = Vec::new();
+    for by in 0..bh {
+        for bx in 0..bw {
+            let mut px = Vec::new();
+            for y in by * BLOCK..((by + 1) * BLOCK).min(ours.h) {
+                for x in bx * BLOCK..((bx + 1) * BLOCK).min(ours.w) {
+                    px.push(y * ours.w + x);
+                }
+            }
+            regions.push(px);
+        }
+    }
+    regions.push((0..n_pix).collect());
+    let region_level = sidak(ALPHA, regions.len() * 3);
+    let mut region_fail = None;
+    for (ri, px) in regions.iter().enumerate() {
+        for c in 0..3 {
+            let avg = |img: &[[f64; 3]]| px.iter().map(|&i| img[i][c]).sum::<f64>() / px.len() as f64;
+            let per_batch: Vec<f64> = batches.iter().map(|b| avg(&b.mean)).collect();
+            let m = per_batch.iter().sum::<f64>() / BATCHES as f64;
+            let s2 = per_batch.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (BATCHES - 1) as f64;
+            let var_ours = s2 / BATCHES as f64;
+            let var_ref = px.iter().map(|&i| ref_var[i][c]).sum::<f64>() / (px.len() * px.len()) as f64;
+            let d = m - avg(&ref_mean);
+            let var = var_ours + var_ref;
+            let p = if var > 0.0 {
+                t_p_value(d / var.sqrt(), (BATCHES - 1) as f64)
+            } else if d.abs() > 1e-6 {
+                0.0
+            } else {
+                1.0
+            };
+            if p < region_level && region_fail.is_none() {
+                let what = if ri + 1 == regions.len() { "whole image".to_string() } else { format!("block {}", ri) };
+                region_fail = Some(format!(
+                    "{} channel {}: ours {:.6} ref {:.6} (rel {:+.3}%), p = {:.2e} < {:.2e}",
+                    what,
+                    c,
+                    m,
+                    avg(&ref_mean),
+                    100.0 * d / avg(&ref_mean).abs().max(1e-12),
+                    p,
+                    region_level
+                ));
+            }
+        }
+    }
+    if min_p < level || region_fail.is_some() {
+        let dir = write_failure(name, &ours, &z);
+        panic!(
+            "{}: differs from the Mitsuba reference.\n  per-pixel: min p = {:.2e} (level {:.2e}); worst {}\n  regions: {}\n  images in {}",
+            name,
+            min_p,
+            level,
+            worst,
+            region_fail.unwrap_or_else(|| "ok".into()),
+            dir.display()
+        );
+    }
+    eprintln!("{}: per-pixel min p = {:.3e} (level {:.2e}); blocks and image mean pass", name, min_p, level);
+}
+
+#[test]
+fn t_distribution_sanity() {
+    // t = 2.131 with 15 dof has a two-sided p of 0.05.
+    assert!((t_p_value(2.131, 15.0) - 0.05).abs() < 5e-4);
+    assert!((t_p_value(0.0, 15.0) - 1.0).abs() < 1e-9);
+}
