@@ -124,6 +124,20 @@ def main():
         print(f"    ({fmt(ref)}, {fmt(wgt)}),")
     print("];")
 
+    spot_tex = mi.load_dict({"type": "spot", "cutoff_angle": 40.0, "to_world": spot_to_world,
+                             "texture": {"type": "bitmap", "filename": os.path.join(DATA, "tex_rgb8.png")}})
+    print("// spot: cutoff 40 (beam 30), texture tex_rgb8.png, to_world = SPOT_TO_WORLD")
+    print("const SPOT_TEXTURED_WEIGHT: &[([f32; 3], [f32; 3])] = &[")
+    for ang, phi in [(0, 0), (10, 0.3), (20, 2.0), (25, -1.0), (33, 4.0), (38, 1.0), (45, 0)]:
+        a = math.radians(ang)
+        local = np.array([math.sin(a) * math.cos(phi), math.sin(a) * math.sin(phi), math.cos(a)])
+        ref = np.array([1, 2, 3]) + 2.5 * np.array(spot_to_world @ mi.ScalarVector3f(local))
+        it = mi.Interaction3f()
+        it.p = mi.Point3f(ref)
+        ds, wgt = spot_tex.sample_direction(it, mi.Point2f(0.5, 0.5))
+        print(f"    ({fmt(ref)}, {fmt(wgt)}),")
+    print("];")
+
     # ---- point, directional, constant ----
     it = mi.Interaction3f()
     it.p = mi.Point3f(0.3, -0.2, 0.5)

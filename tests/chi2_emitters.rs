@@ -117,6 +117,16 @@ const SPOT_WEIGHT: &[([f32; 3], [f32; 3])] = &[
     ([3.511473656e+00, 5.932933092e-01, 3.351676673e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
     ([1.671816289e+00, 1.180217683e+00, 5.699373960e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
 ];
+// spot: cutoff 40 (beam 30), texture tex_rgb8.png, to_world = SPOT_TO_WORLD
+const SPOT_TEXTURED_WEIGHT: &[([f32; 3], [f32; 3])] = &[
+    ([1.000000000e+00, -4.253563881e-01, 3.606339097e+00], [2.275791392e-02, 3.005131520e-02, 8.107264526e-03]),
+    ([1.414731085e+00, -3.573944569e-01, 3.721588373e+00], [3.316377103e-02, 3.791876510e-02, 1.495297998e-02]),
+    ([6.441735029e-01, -9.051918983e-02, 4.324053407e+00], [1.340137888e-02, 8.002010733e-02, 1.257606223e-02]),
+    ([1.570854068e+00, -4.137463570e-01, 2.687022209e+00], [4.040766135e-02, 9.757268243e-03, 4.368503578e-03]),
+    ([1.100004315e-01, -2.839982510e-01, 2.508825243e+00], [3.523127874e-03, 3.242689185e-03, 3.136384184e-04]),
+    ([1.831608236e+00, 4.029138088e-01, 4.734284878e+00], [1.186773740e-02, 1.892802864e-02, 1.442172285e-02]),
+    ([2.767766953e+00, 2.850140333e-01, 3.428746492e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
+];
 // spot with defaults (cutoff 20, beam 15) at the origin, along +z; reference points
 const SPOT_DEFAULT_WEIGHT: &[([f32; 3], [f32; 3])] = &[
     ([0.000000000e+00, 0.000000000e+00, 2.000000000e+00], [2.500000000e-01, 2.500000000e-01, 2.500000000e-01]),
@@ -190,6 +200,27 @@ fn spot_matches_mitsuba() {
     for &(p, want) in SPOT_DEFAULT_WEIGHT {
         let (_, w) = e.sample_direction(v3(p), Vec2::splat(0.5));
         assert_close(w, v3(want), 1e-4, &format!("default spot weight from {p:?}"));
+    }
+}
+
+#[test]
+fn textured_spot_matches_mitsuba() {
+    let pos = SrcPos::new("scene.xml", 9, 9);
+    let mut tp = Props::new(PluginKind::Texture, "bitmap", pos.clone());
+    tp.push("filename", Value::String("tex_rgb8.png".into()), pos.clone()).unwrap();
+    let tex = ObjectDesc { kind: PluginKind::Texture, plugin: "bitmap".into(), id: None, pos, props: tp };
+    let e = emitter(
+        "spot",
+        vec![
+            ("cutoff_angle", Value::Float(40.0)),
+            ("to_world", transform(SPOT_TO_WORLD)),
+            ("texture", Value::Object(std::rc::Rc::new(tex))),
+        ],
+    );
+    for &(p, want) in SPOT_TEXTURED_WEIGHT {
+        let (_, w) = e.sample_direction(v3(p), Vec2::splat(0.5));
+        // Mitsuba keeps 8-bit textures in half precision.
+        assert_close(w, v3(want), 1e-3, &format!("textured spot weight from {p:?}"));
     }
 }
 
