@@ -31,7 +31,6 @@ use crate::scene::desc::Props;
 use crate::scene::resolver::FileResolver;
 use crate::scene::{Error, Result};
 use glam::Affine2;
-use std::sync::Arc;
 
 /// How pixel values are interpolated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -75,7 +74,7 @@ pub struct BitmapTexture {
     pub width: usize,
     pub height: usize,
     /// Linear colours, row 0 at the top (v = 0).
-    data: Arc<[Spectrum]>,
+    data: Vec<Spectrum>,
     pub filter: FilterType,
     pub wrap: WrapMode,
     pub to_uv: Affine2,
@@ -170,7 +169,7 @@ impl BitmapTexture {
             sum += p.as_dvec3();
         }
         let mean = (sum / pixels.len() as f64).as_vec3();
-        Ok(BitmapTexture { filename, width, height, data: pixels.into(), filter, wrap, to_uv, mean })
+        Ok(BitmapTexture { filename, width, height, data: pixels, filter, wrap, to_uv, mean })
     }
 
     #[inline]

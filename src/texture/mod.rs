@@ -16,13 +16,15 @@ use crate::scene::desc::{ObjectDesc, TexArg};
 use crate::scene::resolver::FileResolver;
 use crate::scene::{Error, Result};
 use glam::{Affine2, Mat2};
+use std::sync::Arc;
 
-/// A texture, evaluated at surface uv.
+/// A texture, evaluated at surface uv. Small (16 bytes): the variants with data are behind pointers.
 #[derive(Clone, Debug)]
 pub enum Texture {
     Const(Spectrum),
     Checkerboard(Box<Checkerboard>),
-    Bitmap(BitmapTexture),
+    /// Shared: cloning a texture does not copy its pixels.
+    Bitmap(Arc<BitmapTexture>),
 }
 
 /// The texture plugins [`Texture::from_arg`] accepts.
@@ -41,7 +43,7 @@ impl Texture {
     pub fn from_desc(obj: &ObjectDesc, resolver: &FileResolver) -> Result<Texture> {
         let t = match obj.plugin.as_str() {
             "checkerboard" => Texture::Checkerboard(Box::new(Checkerboard::from_props(&obj.props, resolver)?)),
-            "bitmap" => Texture::Bitmap(BitmapTexture::from_props(&obj.props, resolver)?),
+            "bitmap" => Texture::Bitmap(Arc::new(BitmapTexture::from_props(&obj.props, resolver)?)),
             other => {
                 return Err(Error::at(
                     &obj.pos,
@@ -84,4 +86,14 @@ pub fn uv_transform(m: &Mat4) -> Affine2 {
         Mat2::from_cols(Vec2::new(m.x_axis.x, m.x_axis.y), Vec2::new(m.y_axis.x, m.y_axis.y)),
         Vec2::new(m.w_axis.x, m.w_axis.y),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texture_is_small() {
+        assert!(std::mem::size_of::<Texture>() <= 16);
+    }
 }
