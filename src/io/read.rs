@@ -1,1 +1,217 @@
-//! Reading images (EXR, PNG) into float RGB(A) bitmaps.
+//! Reading images (EXR, PNG) into float bitmaps with named channels.
+//!
+//! - OpenEXR: any compression the `exr` crate decodes (none, RLE, ZIP, ZIPS, PIZ, PXR24, B44),
+//!   half / float / uint samples, any channel set (the first layer of a multi-layer file). Channels
+//!   keep their names: Mitsuba writes half-float PIZ files whose channels are stored B, G, R, so
+//!   callers look channels up by name ([`Bitmap::channel`], [`Bitmap::rgb`]), never by position.
+//! - PNG: 8 or 16 bit, grey, grey+alpha, RGB, RGBA (palette images are expanded to RGB(A)).
+//!   With `srgb_to_linear` the colour channels (not alpha) go through the sRGB transfer curve,
+//!   as Mitsuba does for 8/16-bit images unless a texture asks for `raw` data.
+//!
+//! Every failure is an [`Error::in_file`] naming the file.
+
+use crate::color::Spectrum;
+use crate::scene::{Error, Result};
+use std::path::Path;
+
+/// A decoded image: `channels.len()` interleaved float channels per pixel, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bitmap {
+    pub width: usize,
+    pub height: usize,
+    /// Channel names in storage order ("R", "G", "B", "A", "Y", or any EXR channel name).
+    pub channels: Vec<String>,
+    /// `width · height · channels.len()` samples, pixel (x, y) at `(y · width + x) · channels.len()`.
+    pub data: Vec<f32>,
+}
+
+/// Where the colour of a pixel comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorLayout {
+    /// Offsets of the R, G and B channels.
+    Rgb([usize; 3]),
+    /// Offset of a luminance channel `Y`, broadcast to grey.
+    Y(usize),
+}
+
+impl Bitmap {
+    /// Offset of the channel called `name` within a pixel.
+    pub fn channel(&self, name: &str) -> Option<usize> {
+        self.channels.iter().position(|c| c == name)
+    }
+
+    /// Where colour comes from: R, G, B when all three exist, else Y; `None` for other layouts.
+    pub fn color_layout(&self) -> Option<ColorLayout> {
+        if let (Some(r), Some(g), Some(b)) = (self.channel("R"), self.channel("G"), self.channel("B")) {
+            return Some(ColorLayout::Rgb([r, g, b]));
+        }
+        self.channel("Y").map(ColorLayout::Y)
+    }
+
+    /// The colour layout, or an error naming `file` and the channels found.
+    pub fn require_color(&self, file: &str) -> Result<ColorLayout> {
+        self.color_layout().ok_or_else(|| {
+            Error::in_file(
+                file,
+                format!(
+                    "image has channels [{}]; expected R, G, B (optionally A) or a luminance channel Y",
+                    self.channels.join(", ")
+                ),
+            )
+        })
+    }
+
+    /// Colour of pixel (x, y): R, G, B, or Y broadcast to grey. Black when the image has neither
+    /// (check [`Bitmap::color_layout`] when loading) or when (x, y) is outside the image.
+    pub fn rgb(&self, x: usize, y: usize) -> Spectrum {
+        if x >= self.width || y >= self.height {
+            return Spectrum::ZERO;
+        }
+        let base = (y * self.width + x) * self.channels.len();
+        let at = |c: usize| self.data.get(base + c).copied().unwrap_or(0.0);
+        match self.color_layout() {
+            Some(ColorLayout::Rgb([r, g, b])) => Spectrum::new(at(r), at(g), at(b)),
+            Some(ColorLayout::Y(c)) => Spectrum::splat(at(c)),
+            None => Spectrum::ZERO,
+        }
+    }
+
+    /// All pixels as colours, row by row (see [`Bitmap::rgb`]); an error when there is no colour.
+    pub fn to_rgb_pixels(&self, file: &str) -> Result<Vec<Spectrum>> {
+        let layout = self.require_color(file)?;
+        let n = self.channels.len();
+        Ok(self
+            .data
+            .chunks_exact(n)
+            .map(|p| match layout {
+                ColorLayout::Rgb([r, g, b]) => Spectrum::new(p[r], p[g], p[b]),
+                ColorLayout::Y(c) => Spectrum::splat(p[c]),
+            })
+            .collect())
+    }
+}
+
+/// Read an OpenEXR or PNG file (detected from its first bytes, not its extension).
+/// `srgb_to_linear` linearises the colour channels of 8/16-bit PNG data; EXR data is linear already.
+pub fn read_image(path: &Path, srgb_to_linear: bool) -> Result<Bitmap> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| Error::in_file(&file, format!("cannot read image: {e}")))?;
+    let bitmap = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        read_exr(&bytes, &file)?
+    } else if bytes.starts_with(&[0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a]) {
+        read_png(&bytes, &file, srgb_to_linear)?
+    } else {
+        return Err(Error::in_file(&file, "unsupported image format (expected OpenEXR or PNG)"));
+    };
+    if bitmap.width == 0 || bitmap.height == 0 || bitmap.channels.is_empty() {
+        return Err(Error::in_file(&file, "image is empty"));
+    }
+    Ok(bitmap)
+}
+
+fn read_exr(bytes: &[u8], file: &str) -> Result<Bitmap> {
+    use exr::prelude::{read, FlatSamples, ReadChannels, ReadLayers, Vec2};
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes))
+        .map_err(|e| Error::in_file(file, format!("cannot decode OpenEXR: {e}")))?;
+    let layer = &image.layer_data;
+    let (width, height) = (layer.size.width(), layer.size.height());
+    let list = &layer.channel_data.list;
+    let nc = list.len();
+    let mut channels = Vec::with_capacity(nc);
+    let mut data = vec![0.0f32; width * height * nc];
+    for (c, ch) in list.iter().enumerate() {
+        let name = ch.name.to_string();
+        if ch.sampling != Vec2(1, 1) {
+            return Err(Error::in_file(file, format!("channel \"{name}\" is subsampled, which is not supported")));
+        }
+        let samples: Vec<f32> = match &ch.sample_data {
+            FlatSamples::F16(v) => v.iter().map(|h| h.to_f32()).collect(),
+            FlatSamples::F32(v) => v.clone(),
+            FlatSamples::U32(v) => v.iter().map(|&u| u as f32).collect(),
+        };
+        if samples.len() != width * height {
+            return Err(Error::in_file(
+                file,
+                format!("channel \"{name}\" has {} samples, expected {}", samples.len(), width * height),
+            ));
+        }
+        for (i, s) in samples.into_iter().enumerate() {
+            data[i * nc + c] = s;
+        }
+        channels.push(name);
+    }
+    Ok(Bitmap { width, height, channels, data })
+}
+
+fn read_png(bytes: &[u8], file: &str, srgb_to_linear: bool) -> Result<Bitmap> {
+    use image::DynamicImage as D;
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
+        .map_err(|e| Error::in_file(file, format!("cannot decode PNG: {e}")))?;
+    let (width, height) = (img.width() as usize, img.height() as usize);
+    let (names, alpha, data): (&[&str], bool, Vec<f32>) = match img {
+        D::ImageLuma8(i) => (&["Y"], false, unorm8(i.as_raw())),
+        D::ImageLumaA8(i) => (&["Y", "A"], true, unorm8(i.as_raw())),
+        D::ImageRgb8(i) => (&["R", "G", "B"], false, unorm8(i.as_raw())),
+        D::ImageRgba8(i) => (&["R", "G", "B", "A"], true, unorm8(i.as_raw())),
+        D::ImageLuma16(i) => (&["Y"], false, unorm16(i.as_raw())),
+        D::ImageLumaA16(i) => (&["Y", "A"], true, unorm16(i.as_raw())),
+        D::ImageRgb16(i) => (&["R", "G", "B"], false, unorm16(i.as_raw())),
+        D::ImageRgba16(i) => (&["R", "G", "B", "A"], true, unorm16(i.as_raw())),
+        other => {
+            return Err(Error::in_file(file, format!("unsupported PNG pixel type {:?}", other.color())));
+        }
+    };
+    let mut data = data;
+    if srgb_to_linear {
+        let n = names.len();
+        let colour = if alpha { n - 1 } else { n };
+        for px in data.chunks_exact_mut(n) {
+            for v in &mut px[..colour] {
+                *v = srgb_to_linear_value(*v);
+            }
+        }
+    }
+    Ok(Bitmap { width, height, channels: names.iter().map(|s| s.to_string()).collect(), data })
+}
+
+fn unorm8(v: &[u8]) -> Vec<f32> {
+    v.iter().map(|&b| b as f32 / 255.0).collect()
+}
+
+fn unorm16(v: &[u16]) -> Vec<f32> {
+    v.iter().map(|&b| b as f32 / 65535.0).collect()
+}
+
+/// The sRGB electro-optical transfer function (IEC 61966-2-1), in double precision like Mitsuba's table.
+pub fn srgb_to_linear_value(v: f32) -> f32 {
+    let v = v as f64;
+    (if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }) as f32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_curve_endpoints() {
+        assert_eq!(srgb_to_linear_value(0.0), 0.0);
+        assert!((srgb_to_linear_value(1.0) - 1.0).abs() < 1e-6);
+        assert!((srgb_to_linear_value(0.5) - 0.214_041_14).abs() < 1e-6);
+    }
+
+    #[test]
+    fn rgb_falls_back_to_y() {
+        let b = Bitmap { width: 1, height: 1, channels: vec!["A".into(), "Y".into()], data: vec![0.5, 2.0] };
+        assert_eq!(b.rgb(0, 0), Spectrum::splat(2.0));
+        assert_eq!(b.color_layout(), Some(ColorLayout::Y(1)));
+        let b = Bitmap { width: 1, height: 1, channels: vec!["Z".into()], data: vec![1.0] };
+        assert!(b.require_color("x.exr").is_err());
+        assert_eq!(b.rgb(0, 0), Spectrum::ZERO);
+    }
+}
