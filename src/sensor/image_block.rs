@@ -104,7 +104,7 @@ impl ImageBlock {
 
         let radius = match self.kernel {
             FilterKernel::Box => {
-                let (x, y) = (pos.x.floor() as i64 - ox, pos.y.floor() as i64 - oy);
+                let (x, y) = ((pos.x.floor() as i64).saturating_sub(ox), (pos.y.floor() as i64).saturating_sub(oy));
                 if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
                     return;
                 }

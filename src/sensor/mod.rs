@@ -7,7 +7,9 @@
 //!
 //! Rendering a pixel the way Mitsuba does: for each pixel `(x, y)` of [`Film::sample_window`], take
 //! `pos = (x, y) + sampler.next_2d()`, trace `camera.sample_ray(pos, aperture)` and splat the result
-//! at `pos` into an [`ImageBlock`] (tiles from `ImageBlock::new`, merged into `film.create_block`).
+//! at `pos` into an [`ImageBlock`] (tiles from `ImageBlock::new`, merged into `film.create_block`;
+//! with the box filter the sample lands in pixel `(x, y)`, as in Mitsuba). The developed block is
+//! written with `io::write::write_exr(path, crop_w, crop_h, film.channel_names(), &block.develop())`.
 //!
 //! ```xml
 //! <sensor type="perspective">
