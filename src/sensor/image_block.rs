@@ -1,0 +1,238 @@
+//! Filtered accumulation of samples into a rectangle of pixels (Mitsuba's `ImageBlock`).
+//!
+//! A sample at continuous film position `pos` adds `w(x)·w(y)·value` to every pixel whose centre
+//! lies within the filter radius of `pos` (`x`, `y`: offsets of the pixel centre from `pos`, in
+//! pixels), and the weight `w(x)·w(y)` to a weight channel; [`ImageBlock::develop`]
+//! divides the two. A filter of radius 0.5 (the box) puts the whole sample into the pixel that
+//! contains `pos`, as Mitsuba does.
+//!
+//! Blocks store a border of [`RFilter::border_size`] pixels around their interior, so a tile
+//! receives every contribution of the samples taken inside it and tiles merge exactly into the
+//! full image. Weights are computed from film coordinates, so a sample contributes identical
+//! weights whichever block it is put into.
+
+use super::rfilter::{FilterKernel, RFilter};
+use glam::Vec2;
+
+/// Largest filter footprint (pixels per axis) whose x weights are cached on the stack.
+const MAX_CACHED_TAPS: usize = 32;
+
+#[derive(Clone, Debug)]
+pub struct ImageBlock {
+    /// Film position of the interior's top-left pixel.
+    offset: (i32, i32),
+    /// Interior size in pixels.
+    size: (u32, u32),
+    border: u32,
+    channels: usize,
+    filter: RFilter,
+    kernel: FilterKernel,
+    /// Storage (interior plus border), row-major, `channels` values then the weight per pixel.
+    data: Vec<f32>,
+}
+
+impl ImageBlock {
+    /// A zeroed block for the interior rectangle `offset`, `size` (film pixels), with
+    /// `channels` value channels and the border the filter needs.
+    pub fn new(offset: (i32, i32), size: (u32, u32), filter: RFilter, channels: usize) -> ImageBlock {
+        let mut block = ImageBlock {
+            offset,
+            size: (0, 0),
+            border: filter.border_size(),
+            channels,
+            filter,
+            kernel: FilterKernel::for_splatting(&filter),
+            data: Vec::new(),
+        };
+        block.reset(offset, size);
+        block
+    }
+
+    /// Move and resize the block and zero it, keeping its allocation (to reuse one block per thread).
+    pub fn reset(&mut self, offset: (i32, i32), size: (u32, u32)) {
+        self.offset = offset;
+        self.size = size;
+        let (w, h) = self.storage_size();
+        self.data.clear();
+        self.data.resize(w * h * (self.channels + 1), 0.0);
+    }
+
+    /// Zero all pixels and weights.
+    pub fn clear(&mut self) {
+        self.data.fill(0.0);
+    }
+
+    pub fn offset(&self) -> (i32, i32) {
+        self.offset
+    }
+    pub fn size(&self) -> (u32, u32) {
+        self.size
+    }
+    /// Border width in pixels on each side of the interior.
+    pub fn border(&self) -> u32 {
+        self.border
+    }
+    /// Number of value channels (the weight channel not included).
+    pub fn channels(&self) -> usize {
+        self.channels
+    }
+    pub fn filter(&self) -> RFilter {
+        self.filter
+    }
+
+    /// Width and height of the storage, border included.
+    fn storage_size(&self) -> (usize, usize) {
+        let b = 2 * self.border as usize;
+        (self.size.0 as usize + b, self.size.1 as usize + b)
+    }
+
+    /// Film position of the storage's top-left pixel.
+    fn storage_origin(&self) -> (i64, i64) {
+        (self.offset.0 as i64 - self.border as i64, self.offset.1 as i64 - self.border as i64)
+    }
+
+    /// Splat a sample at film position `pos` (pixels) with `values` (one per channel).
+    /// Samples with a non-finite position are ignored; contributions outside the storage are dropped.
+    pub fn put(&mut self, pos: Vec2, values: &[f32]) {
+        debug_assert_eq!(values.len(), self.channels, "ImageBlock::put: wrong number of values");
+        if !pos.is_finite() {
+            return;
+        }
+        let (ox, oy) = self.storage_origin();
+        let (w, h) = self.storage_size();
+        let stride = self.channels + 1;
+
+        let radius = match self.kernel {
+            FilterKernel::Box => {
+                let (x, y) = ((pos.x.floor() as i64).saturating_sub(ox), (pos.y.floor() as i64).saturating_sub(oy));
+                if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
+                    return;
+                }
+                let base = (y as usize * w + x as usize) * stride;
+                let px = &mut self.data[base..base + stride];
+                for (d, v) in px.iter_mut().zip(values) {
+                    *d += v;
+                }
+                px[self.channels] += 1.0;
+                return;
+            }
+            k => k.radius(),
+        };
+
+        // Pixels i with centre i + 0.5 within the radius of pos, clipped to the storage.
+        let x0 = ((pos.x - 0.5 - radius).ceil() as i64).max(ox);
+        let x1 = ((pos.x - 0.5 + radius).floor() as i64).min(ox + w as i64 - 1);
+        let y0 = ((pos.y - 0.5 - radius).ceil() as i64).max(oy);
+        let y1 = ((pos.y - 0.5 + radius).floor() as i64).min(oy + h as i64 - 1);
+        if x0 > x1 || y0 > y1 {
+            return;
+        }
+        let count_x = (x1 - x0 + 1) as usize;
+        let kernel = self.kernel;
+        let mut weights_x = [0.0f32; MAX_CACHED_TAPS];
+        let cached = count_x <= MAX_CACHED_TAPS;
+        if cached {
+            for (i, wx) in weights_x.iter_mut().take(count_x).enumerate() {
+                *wx = kernel.eval((x0 + i as i64) as f32 + 0.5 - pos.x);
+            }
+        }
+        for y in y0..=y1 {
+            let wy = kernel.eval(y as f32 + 0.5 - pos.y);
+            if wy == 0.0 {
+                continue;
+            }
+            let start = ((y - oy) as usize * w + (x0 - ox) as usize) * stride;
+            let row = &mut self.data[start..start + count_x * stride];
+            for (i, px) in row.chunks_exact_mut(stride).enumerate() {
+                let wx = if cached { weights_x[i] } else { kernel.eval((x0 + i as i64) as f32 + 0.5 - pos.x) };
+                let weight = wx * wy;
+                let (px_values, px_weight) = px.split_at_mut(self.channels);
+                for (d, v) in px_values.iter_mut().zip(values) {
+                    *d += v * weight;
+                }
+                px_weight[0] += weight;
+            }
+        }
+    }
+
+    /// Add another block (a tile, border included) into this one where their storages overlap.
+    /// Panics if the channel counts differ (a programming error, not a user error).
+    pub fn merge(&mut self, other: &ImageBlock) {
+        assert_eq!(self.channels, other.channels, "ImageBlock::merge: channel counts differ");
+        let stride = self.channels + 1;
+        let (sx, sy) = self.storage_origin();
+        let (sw, sh) = self.storage_size();
+        let (ox, oy) = other.storage_origin();
+        let (ow, oh) = other.storage_size();
+        let x0 = sx.max(ox);
+        let x1 = (sx + sw as i64).min(ox + ow as i64);
+        let y0 = sy.max(oy);
+        let y1 = (sy + sh as i64).min(oy + oh as i64);
+        if x0 >= x1 || y0 >= y1 {
+            return;
+        }
+        let n = (x1 - x0) as usize * stride;
+        for y in y0..y1 {
+            let dst = ((y - sy) as usize * sw + (x0 - sx) as usize) * stride;
+            let src = ((y - oy) as usize * ow + (x0 - ox) as usize) * stride;
+            for (d, s) in self.data[dst..dst + n].iter_mut().zip(&other.data[src..src + n]) {
+                *d += s;
+            }
+        }
+    }
+
+    /// The interior pixels, row 0 at the top, channels interleaved, each divided by the pixel's
+    /// accumulated filter weight (0 where the weight is 0).
+    pub fn develop(&self) -> Vec<f32> {
+        let (iw, ih) = (self.size.0 as usize, self.size.1 as usize);
+        let (w, _) = self.storage_size();
+        let b = self.border as usize;
+        let stride = self.channels + 1;
+        let mut out = Vec::with_capacity(iw * ih * self.channels);
+        for y in 0..ih {
+            for x in 0..iw {
+                let base = ((y + b) * w + x + b) * stride;
+                let px = &self.data[base..base + stride];
+                let weight = px[self.channels];
+                let inv = if weight != 0.0 { 1.0 / weight } else { 0.0 };
+                out.extend(px[..self.channels].iter().map(|v| v * inv));
+            }
+        }
+        out
+    }
+
+    /// The accumulated filter weight of interior pixel `(x, y)` (relative to the block's offset).
+    pub fn weight(&self, x: u32, y: u32) -> f32 {
+        let (w, _) = self.storage_size();
+        let b = self.border as usize;
+        let idx = ((y as usize + b) * w + x as usize + b) * (self.channels + 1) + self.channels;
+        self.data.get(idx).copied().unwrap_or(0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_puts_into_containing_pixel() {
+        let mut b = ImageBlock::new((2, 3), (4, 4), RFilter::Box, 1);
+        b.put(Vec2::new(3.9, 3.0), &[2.0]);
+        b.put(Vec2::new(3.1, 3.5), &[4.0]);
+        b.put(Vec2::new(100.0, 3.5), &[4.0]);
+        b.put(Vec2::new(f32::NAN, 3.5), &[4.0]);
+        let img = b.develop();
+        assert_eq!(img[1], 3.0);
+        assert_eq!(img.iter().filter(|v| **v != 0.0).count(), 1);
+        assert_eq!(b.weight(1, 0), 2.0);
+    }
+
+    #[test]
+    fn footprint_of_gaussian() {
+        let mut b = ImageBlock::new((0, 0), (10, 10), RFilter::default(), 1);
+        b.put(Vec2::new(5.0, 5.0), &[1.0]);
+        // Centres 3.5 .. 6.5 are within 2 of 5.0 → 4 pixels per axis, weight 0 exactly at ±2 not reached.
+        let touched = (0..10).flat_map(|y| (0..10).map(move |x| (x, y))).filter(|&(x, y)| b.weight(x, y) > 0.0).count();
+        assert_eq!(touched, 16);
+    }
+}
