@@ -59,8 +59,8 @@ fn emitter_name(e: &SceneEmitter) -> &'static str {
 }
 
 pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
-    let film = &scene.sensor.film;
-    let sampler = &scene.sensor.sampler;
+    let film = &scene.film;
+    let sampler = &scene.sampler;
     let sampler_kind = match sampler.kind {
         SamplerKind::Independent => "independent",
         SamplerKind::Stratified => "stratified (rendered as independent)",

@@ -83,9 +83,10 @@ pub fn check_renderable(scene: &Scene) -> Result<(), String> {
 
 /// Render the scene. `cancel` stops early (Ctrl-C); the samples done so far are kept.
 pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> RenderOutput {
-    let film = &scene.sensor.film;
+    let film = &scene.film;
     let (cw, ch) = film.crop_size;
-    let (cx, cy) = film.crop_offset;
+    // Samples are taken in the sample window (the crop window, plus the filter border with `sample_border`).
+    let ((sx, sy), (sw, sh)) = film.sample_window();
     let rgba = matches!(film.pixel_format, PixelFormat::Rgba);
     let moment = scene.integrator.moment;
     // Channels: RGB, [A], [second moment of RGB].
@@ -102,19 +103,19 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
     let total_spp = match (opts.spp, opts.time_budget) {
         (Some(s), _) => s,
         (None, Some(_)) => u32::MAX,
-        (None, None) => scene.sensor.sampler.sample_count,
+        (None, None) => scene.sampler.sample_count,
     };
 
     let mut tiles = Vec::new();
-    for ty in (0..ch).step_by(TILE as usize) {
-        for tx in (0..cw).step_by(TILE as usize) {
-            tiles.push((cx + tx, cy + ty, TILE.min(cw - tx), TILE.min(ch - ty)));
+    for ty in (0..sh).step_by(TILE as usize) {
+        for tx in (0..sw).step_by(TILE as usize) {
+            tiles.push((sx + tx as i32, sy + ty as i32, TILE.min(sw - tx), TILE.min(sh - ty)));
         }
     }
-    let full = Mutex::new(ImageBlock::new((cx as i32, cy as i32), (cw, ch), film.filter, nch));
+    let full = Mutex::new(film.create_block(nch));
     let stats = Stats::default();
     let start = Instant::now();
-    let pixels = cw as u64 * ch as u64;
+    let pixels = sw as u64 * sh as u64;
     let bar = if opts.progress {
         let len = if total_spp == u32::MAX { 0 } else { total_spp as u64 * pixels };
         let b = indicatif::ProgressBar::new(len);
@@ -144,17 +145,18 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
             if cancel.load(Ordering::Relaxed) {
                 return;
             }
-            let mut block = ImageBlock::new((x0 as i32, y0 as i32), (w, h), film.filter, nch);
+            let mut block = ImageBlock::new((x0, y0), (w, h), film.filter, nch);
             let mut local = LocalStats::default();
             let mut values = vec![0.0f32; nch];
-            for y in y0..y0 + h {
-                for x in x0..x0 + w {
-                    let pixel_index = y as u64 * film.width as u64 + x as u64;
+            for y in y0..y0 + h as i32 {
+                for x in x0..x0 + w as i32 {
+                    // Unique per film pixel (the border may lie outside the film: offset it).
+                    let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
                     let mut sampler = Sampler::new(opts.seed, pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(first_sample as u64));
                     for _ in 0..pass_spp {
                         let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
                         let aperture = sampler.next_2d();
-                        let ray = scene.sensor.camera.sample_ray(pos, aperture);
+                        let ray = scene.camera.sample_ray(pos, aperture);
                         let (mut l, valid) = sample_li(scene, &mut sampler, ray, &mut local);
                         if !l.is_finite() {
                             local.rejected_samples += 1;

@@ -10,7 +10,7 @@ use super::{Error, Result};
 use crate::bsdf::Bsdf;
 use crate::emitter::Emitter;
 use crate::integrator::IntegratorDesc;
-use crate::math::{Aabb, Mat4, Vec3};
+use crate::math::{Aabb, Vec3};
 use crate::medium::Homogeneous;
 use crate::sensor::Sensor;
 use crate::shape::accel::Accel;
@@ -137,7 +137,9 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         emitters: b.emitters,
         environment: b.environment.map(|e| e.0),
         media: b.media,
-        sensor,
+        camera: sensor.camera,
+        film: sensor.film,
+        sampler: sensor.sampler,
         sensor_medium,
         integrator,
         bounds,

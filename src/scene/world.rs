@@ -8,7 +8,9 @@ use crate::integrator::IntegratorDesc;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
 use crate::medium::Homogeneous;
-use crate::sensor::Sensor;
+use crate::sensor::film::Film;
+use crate::sensor::sampler_desc::SamplerDesc;
+use crate::sensor::Camera;
 use crate::shape::accel::Accel;
 use crate::shape::Shape;
 use crate::texture::Texture;
@@ -29,7 +31,9 @@ pub struct Scene {
     /// Index of the environment emitter (envmap or constant), if any.
     pub environment: Option<u32>,
     pub media: Vec<Homogeneous>,
-    pub sensor: Sensor,
+    pub camera: Camera,
+    pub film: Film,
+    pub sampler: SamplerDesc,
     /// Medium the camera sits in.
     pub sensor_medium: Option<u32>,
     pub integrator: IntegratorDesc,
