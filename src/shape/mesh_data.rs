@@ -106,6 +106,21 @@ impl MeshData {
     }
 }
 
+/// Normalise as Mitsuba does (`n * rsqrt(|n|²)`, in single precision). Zero or non-finite
+/// normals are returned unchanged so that [`MeshData::validate`] reports them.
+pub(crate) fn normalize_normal(n: Vec3) -> Vec3 {
+    let len2 = n.length_squared();
+    if len2 > 0.0 && len2.is_finite() {
+        n * (1.0 / len2.sqrt())
+    } else if n.is_finite() && n != Vec3::ZERO {
+        // |n|² under- or overflows in f32.
+        let d = n.as_dvec3();
+        (d / d.length()).as_vec3()
+    } else {
+        n
+    }
+}
+
 fn fmt_vec3(v: Vec3) -> String {
     format!("({}, {}, {})", v.x, v.y, v.z)
 }

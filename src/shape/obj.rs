@@ -32,7 +32,7 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 use std::path::Path;
 
-use super::mesh_data::MeshData;
+use super::mesh_data::{normalize_normal, MeshData};
 use crate::math::{Vec2, Vec3};
 use crate::scene::error::{Error, Result, SrcPos};
 
@@ -70,7 +70,10 @@ pub fn load_obj_from_bytes(bytes: &[u8], file: &str, flip_tex_coords: bool) -> R
     let mut indices: Vec<[u32; 3]> = Vec::new();
     let mut polygon: Vec<u32> = Vec::new();
 
-    for (line_idx, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+    // Lines end in `\n` (or `\r\n`); a file without any `\n` but with `\r` uses classic Mac
+    // line ends (Mitsuba would report one over-long line).
+    let eol = if !bytes.contains(&b'\n') && bytes.contains(&b'\r') { b'\r' } else { b'\n' };
+    for (line_idx, raw) in bytes.split(|&b| b == eol).enumerate() {
         let line_no = u32::try_from(line_idx + 1).unwrap_or(u32::MAX);
         let at = |col: u32, msg: String| Error::at(&SrcPos::new(file, line_no, col), msg);
         let content = match raw.iter().position(|&b| b == b'#') {
@@ -101,11 +104,10 @@ pub fn load_obj_from_bytes(bytes: &[u8], file: &str, flip_tex_coords: bool) -> R
                     }
                     b"vn" => {
                         let n = Vec3::from(x);
-                        let len = n.length();
-                        if !(len > 0.0 && len.is_finite()) {
+                        if !n.is_finite() || n == Vec3::ZERO {
                             return Err(bad("zero-length or non-finite normal"));
                         }
-                        vn.push(n / len);
+                        vn.push(normalize_normal(n));
                     }
                     _ => {
                         let uv = Vec2::new(x[0], if flip_tex_coords { 1.0 - x[1] } else { x[1] });
@@ -312,5 +314,15 @@ mod tests {
         let m = load_obj_from_bytes(obj, "c.obj", true).unwrap();
         assert_eq!(m.indices, vec![[0, 1, 2]]);
         assert!(m.normals.is_empty() && m.uvs.is_empty());
+    }
+
+    #[test]
+    fn line_ends() {
+        for obj in ["v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n", "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r"] {
+            let m = load_obj_from_bytes(obj.as_bytes(), "e.obj", true).unwrap();
+            assert_eq!(m.indices, vec![[0, 1, 2]]);
+        }
+        let e = load_obj_from_bytes(b"v 0 0 0\rv 1 0 0\rf 1 2 3\r", "e.obj", true).unwrap_err();
+        assert_eq!(e.to_string(), "e.obj:3:7: reference to vertex 3, but only 2 are defined so far");
     }
 }

@@ -34,7 +34,7 @@
 
 use std::path::Path;
 
-use super::mesh_data::MeshData;
+use super::mesh_data::{normalize_normal, MeshData};
 use crate::math::{Vec2, Vec3};
 use crate::scene::error::{Error, Result, SrcPos};
 
@@ -801,12 +801,19 @@ fn read_vertices<R: Body>(
             };
             res.map_err(|e| read_err(r, file, e, el, i, p))?;
         }
-        mesh.positions.push(Vec3::new(v[0], v[1], v[2]));
+        // Checked here as well as in `validate`, so that ascii errors carry the line.
+        let p = Vec3::new(v[0], v[1], v[2]);
+        if !p.is_finite() {
+            return Err(r.error(file, format!("vertex {i} has a non-finite position ({}, {}, {})", p.x, p.y, p.z)));
+        }
+        mesh.positions.push(p);
         if plan.has_normals {
             let n = Vec3::new(v[3], v[4], v[5]);
-            let len = n.length();
-            // Zero or non-finite normals stay as they are and fail validation.
-            mesh.normals.push(if len > 0.0 && len.is_finite() { n / len } else { n });
+            if !n.is_finite() || n == Vec3::ZERO {
+                let msg = format!("vertex {i} has a zero-length or non-finite normal ({}, {}, {})", n.x, n.y, n.z);
+                return Err(r.error(file, msg));
+            }
+            mesh.normals.push(normalize_normal(n));
         }
         if plan.has_uvs {
             mesh.uvs.push(Vec2::new(v[6], v[7]));

@@ -31,7 +31,7 @@ use std::path::Path;
 
 use flate2::read::ZlibDecoder;
 
-use super::mesh_data::MeshData;
+use super::mesh_data::{normalize_normal, MeshData};
 use crate::math::{Vec2, Vec3};
 use crate::scene::error::{Error, Result};
 
@@ -247,19 +247,7 @@ impl Stream<'_> {
         };
         if flags & HAS_NORMALS != 0 {
             let n = self.floats(3 * nv, double, "vertex normals")?;
-            mesh.normals = n
-                .chunks_exact(3)
-                .map(|c| {
-                    let n = Vec3::new(c[0], c[1], c[2]);
-                    let len = n.length();
-                    // Zero or non-finite normals stay as they are and fail validation.
-                    if len > 0.0 && len.is_finite() {
-                        n / len
-                    } else {
-                        n
-                    }
-                })
-                .collect();
+            mesh.normals = n.chunks_exact(3).map(|c| normalize_normal(Vec3::new(c[0], c[1], c[2]))).collect();
         }
         if flags & HAS_TEXCOORDS != 0 {
             let uv = self.floats(2 * nv, double, "texture coordinates")?;
