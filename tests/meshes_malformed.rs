@@ -302,3 +302,24 @@ fn malformed_serialized_files() {
     let p = d.0.join("missing.serialized");
     expect_err(&p, load_serialized(&p, 0), "cannot read serialized mesh file");
 }
+
+#[test]
+fn pathological_counts_stay_cheap() {
+    let d = Dir::new("pathological");
+    // An ascii element without properties and 2^64 - 1 records: nothing to read, loads at once.
+    let ply = PLY_HEAD.replace("end_header", "element empty 18446744073709551615\nend_header")
+        + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    let p = d.file("empty_element.ply", ply);
+    assert_eq!(load_ply(&p).unwrap().triangle_count(), 1);
+
+    // A `.serialized` name of 1 MiB non-zero bytes (compresses to almost nothing).
+    let mut body = 0x1000u32.to_le_bytes().to_vec();
+    body.extend(vec![b'a'; 1 << 20]);
+    let mut z = ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+    z.write_all(&body).unwrap();
+    let mut file = 0x041Cu16.to_le_bytes().to_vec();
+    file.extend(4u16.to_le_bytes());
+    file.extend(z.finish().unwrap());
+    let p = d.file("long_name.serialized", file);
+    expect_err(&p, load_serialized(&p, 0), "the name of mesh 0 is longer than 65536 bytes");
+}

@@ -25,8 +25,8 @@
 //! - any other element is skipped, list properties included;
 //! - content after the last element is an error, as in Mitsuba.
 //!
-//! Unlike Mitsuba, face indices out of range, NaN/infinite positions and zero normals are errors
-//! rather than a silently broken mesh. Errors in ascii files carry `file:line:col`; errors in
+//! Non-finite positions are errors, as in Mitsuba; unlike Mitsuba, so are face indices out of
+//! range and zero or non-finite normals (rather than a silently broken mesh). Errors in ascii files carry `file:line:col`; errors in
 //! binary bodies give the byte offset.
 //!
 //! Speed: the whole file is read into memory and decoded by one monomorphised loop per body
@@ -756,6 +756,10 @@ fn skip_list<R: Body>(r: &mut R, count: Scalar, item: Scalar) -> std::result::Re
 }
 
 fn skip_element<R: Body>(r: &mut R, el: &Element, file: &str) -> Result<()> {
+    if el.props.is_empty() {
+        // Records without properties take no space, however many the header declares.
+        return Ok(());
+    }
     let fixed = el.props.iter().all(|p| matches!(p.ty, PropType::Scalar(_)));
     if fixed && r.is_binary() {
         // Size was checked against the remaining bytes in `decode`.

@@ -45,6 +45,9 @@ const DOUBLE_PRECISION: u32 = 0x2000;
 /// counts in the (possibly corrupt) header say.
 const CHUNK: usize = 1 << 16;
 
+/// Longest shape name accepted (names are read byte by byte).
+const MAX_NAME: usize = 1 << 16;
+
 /// Load mesh `shape_index` of a `.serialized` file; the result is validated.
 pub fn load_serialized(path: &Path, shape_index: u32) -> Result<MeshData> {
     let file = path.display().to_string();
@@ -224,7 +227,12 @@ impl Stream<'_> {
         if version == 4 {
             // The shape's name, NUL-terminated (unused).
             let mut b = [0u8; 1];
-            loop {
+            for len in 0.. {
+                if len > MAX_NAME {
+                    let msg =
+                        format!("the name of mesh {} is longer than {MAX_NAME} bytes (corrupt file?)", self.shape);
+                    return Err(Error::in_file(self.file, msg));
+                }
                 self.read(&mut b, "the shape name")?;
                 if b[0] == 0 {
                     break;
