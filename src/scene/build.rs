@@ -237,9 +237,9 @@ impl Builder<'_> {
                 };
                 let path = self.resolver.resolve_at(&name, &props.pos_of("filename"))?;
                 let face_normals = props.bool("face_normals", false)?;
-                let mut data = match obj.plugin.as_str() {
-                    "obj" => obj::load_obj(&path)?,
-                    "ply" => ply::load_ply(&path)?,
+                let data = match obj.plugin.as_str() {
+                    "obj" => obj::load_obj_with(&path, props.bool("flip_tex_coords", true)?)?,
+                    "ply" => ply::load_ply_with(&path, props.bool("flip_tex_coords", false)?)?,
                     _ => {
                         let index = props.int("shape_index", 0)?;
                         if index < 0 || index > u32::MAX as i64 {
@@ -248,11 +248,6 @@ impl Builder<'_> {
                         serialized::load_serialized(&path, index as u32)?
                     }
                 };
-                if obj.plugin == "obj" && props.bool("flip_tex_coords", true)? {
-                    for uv in &mut data.uvs {
-                        uv.y = 1.0 - uv.y;
-                    }
-                }
                 mesh(data, face_normals)
             }
             "rectangle" => mesh(rectangle_data(), false),
