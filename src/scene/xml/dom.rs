@@ -160,14 +160,17 @@ fn element(index: &LineIndex, e: &BytesStart, fallback: usize) -> Result<Element
     let mut attrs: Vec<Attr> = Vec::new();
     for a in e.attributes() {
         let a = a.map_err(|err| {
-            let rel = match &err {
-                quick_xml::events::attributes::AttrError::ExpectedEq(p)
-                | quick_xml::events::attributes::AttrError::ExpectedValue(p)
-                | quick_xml::events::attributes::AttrError::UnquotedValue(p)
-                | quick_xml::events::attributes::AttrError::ExpectedQuote(p, _)
-                | quick_xml::events::attributes::AttrError::Duplicated(p, _) => *p,
+            use quick_xml::events::attributes::AttrError as E;
+            let (rel, what) = match err {
+                E::ExpectedEq(p) => (p, "attribute name not followed by '='".to_string()),
+                E::ExpectedValue(p) => (p, "attribute without a value after '='".to_string()),
+                E::UnquotedValue(p) => (p, "attribute value not in quotes".to_string()),
+                E::ExpectedQuote(p, _) => (p, "attribute value without its closing quote".to_string()),
+                E::Duplicated(p, prev) => {
+                    (p, format!("duplicated attribute (first given at {})", index.pos(lt + 1 + prev)))
+                }
             };
-            Error::at(&index.pos(lt + 1 + rel), format!("malformed XML: bad attribute in <{name}>: {err}"))
+            Error::at(&index.pos(lt + 1 + rel), format!("malformed XML: {what} in <{name}>"))
         })?;
         let key = a.key.as_ref();
         let apos = index.offset_of(key).map_or_else(|| pos.clone(), |o| index.pos(o));

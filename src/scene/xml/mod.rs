@@ -59,6 +59,7 @@ use std::sync::Arc;
 
 /// A parsed scene: the root `<scene>` object and the resolver for its asset files (the scene's
 /// folder and the `<path>` folders).
+#[derive(Debug)]
 pub struct ParsedScene {
     pub root: Rc<ObjectDesc>,
     pub resolver: FileResolver,
