@@ -274,6 +274,7 @@ fn version_0_6_is_upgraded_like_mitsuba() {
 // builds for each <transform> body (checked there against composing mi.ScalarAffineTransform4d
 // operations, each multiplied from the left).
 #[rustfmt::skip]
+#[allow(clippy::approx_constant)] // numbers printed by Mitsuba
 const TRANSFORM_CASES: &[(&str, [[f64; 4]; 4])] = &[
     (r#"<translate x="1" y="2" z="3"/><rotate y="1" angle="30"/>"#, [[0.8660254037844387, 0.0, 0.49999999999999994, 2.3660254037844384], [0.0, 1.0, 0.0, 2.0], [-0.49999999999999994, 0.0, 0.8660254037844387, 2.098076211353316], [0.0, 0.0, 0.0, 1.0]]),
     (r#"<scale value="2"/><rotate value="1, 1, 0" angle="45"/><translate value="0.5 -1 2"/>"#, [[2.0, 0.5857864376269049, 1.414213562373095, 0.5], [0.5857864376269049, 2.0, -1.414213562373095, -1.0], [-1.414213562373095, 1.414213562373095, 1.4142135623730951, 2.0], [0.0, 0.0, 0.0, 1.0]]),
