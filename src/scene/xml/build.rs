@@ -87,12 +87,14 @@ pub fn resolve_refs(nodes: &mut [Node], ids: &HashMap<String, (usize, SrcPos)>) 
         for p in &mut node.props {
             if let NValue::Ref(id) = &p.value {
                 let Some((target, _)) = ids.get(id) else {
+                    let prop = if p.name.starts_with("_arg_") {
+                        String::new()
+                    } else {
+                        format!(" in property \"{}\"", p.name)
+                    };
                     return Err(Error::at(
                         &p.pos,
-                        format!(
-                            "unresolved reference to \"{id}\" in property \"{}\": no object has id=\"{id}\"",
-                            p.name
-                        ),
+                        format!("unresolved reference to \"{id}\"{prop}: no object has id=\"{id}\""),
                     ));
                 };
                 p.value = NValue::Node(*target);

@@ -99,6 +99,8 @@ pub struct Parser {
     pub params: Params,
     /// Canonical paths of the files being parsed (main file first), for include cycles.
     include_stack: Vec<PathBuf>,
+    /// Current element nesting, counted across included files.
+    depth: usize,
 }
 
 /// Check that the attributes are among `allowed` and that `required` are present (Mitsuba's
@@ -131,7 +133,7 @@ fn req<'a>(attrs: &'a [Attr], name: &str, pos: &SrcPos) -> Result<&'a Attr> {
 
 impl Parser {
     pub fn new(params: Params) -> Parser {
-        Parser { nodes: Vec::new(), ids: HashMap::new(), params, include_stack: Vec::new() }
+        Parser { nodes: Vec::new(), ids: HashMap::new(), params, include_stack: Vec::new(), depth: 0 }
     }
 
     /// Parse the main scene document. `resolver` searches the scene's folder; it comes back with
@@ -219,6 +221,20 @@ impl Parser {
 
     /// One element inside an object (or inside the root of a file).
     fn element(&mut self, ctx: &mut FileCtx, el: &Element, parent: usize) -> Result<()> {
+        // Included files nest too: bound the total depth (and so the recursion).
+        if self.depth >= dom::MAX_DEPTH {
+            return Err(Error::at(
+                &el.pos,
+                format!("elements are nested more than {} levels deep (counting included files)", dom::MAX_DEPTH),
+            ));
+        }
+        self.depth += 1;
+        let r = self.element_inner(ctx, el, parent);
+        self.depth -= 1;
+        r
+    }
+
+    fn element_inner(&mut self, ctx: &mut FileCtx, el: &Element, parent: usize) -> Result<()> {
         let mut attrs = self.substitute_all(el)?;
         let tag = el.name.as_str();
         let pos = &el.pos;
