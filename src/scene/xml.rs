@@ -1,1 +1,0 @@
-//! Mitsuba 3 XML parser: text → ObjectDesc tree with positions.
