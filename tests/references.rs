@@ -3,7 +3,9 @@
 //! spp in `reference/NAME.json`) is compared with our render of `scenes/NAME.xml`.
 //!
 //! Three statistical tests, each at family-wise level α = 0.01 with Šidák's correction:
-//! - per pixel: two-sample Z-test, our variance from the second-moment channel;
+//! - per pixel: two-sample Z-test; a pixel's variance is the per-sample variance (ours from the
+//!   second-moment channel, the reference's from `var.*`) times the filter's variance factor
+//!   f = ∫w² / (∫w)² over the samples that reach the pixel (larger near the image border), over N;
 //! - per 8×8 block: Welch-style t-test, our variance from independent batches (exact under the
 //!   pixel filter's correlations), the reference's from its variance channel;
 //! - the whole image (same batch method), which is what catches a ~1 % bias.
@@ -104,10 +106,34 @@ fn sidak(alpha: f64, n: usize) -> f64 {
     1.0 - (1.0 - alpha).powf(1.0 / n.max(1) as f64)
 }
 
+/// Per-pixel variance factor of the reconstruction filter: f(x, y) = f1(x) f1(y) with
+/// f1(p) = ∫₀ᵂ w²(t − p − ½) dt / (∫₀ᵂ w(t − p − ½) dt)² (samples are uniform over the film).
+fn variance_factor(filter: &snee::sensor::rfilter::RFilter, w: usize, h: usize) -> Vec<f64> {
+    let f1 = |p: usize, size: usize| -> f64 {
+        let r = filter.radius() as f64;
+        let steps = 4096;
+        let (lo, hi) = ((p as f64 + 0.5 - r).max(0.0), (p as f64 + 0.5 + r).min(size as f64));
+        let dt = (hi - lo) / steps as f64;
+        let (mut s1, mut s2) = (0.0, 0.0);
+        for i in 0..steps {
+            let t = lo + (i as f64 + 0.5) * dt;
+            let v = filter.eval((t - p as f64 - 0.5) as f32) as f64;
+            s1 += v * dt;
+            s2 += v * v * dt;
+        }
+        s2 / (s1 * s1)
+    };
+    let fx: Vec<f64> = (0..w).map(|x| f1(x, w)).collect();
+    let fy: Vec<f64> = (0..h).map(|y| f1(y, h)).collect();
+    (0..w * h).map(|i| fx[i % w] * fy[i / w]).collect()
+}
+
 /// Render `scene` in `BATCHES` independent batches; returns (batch images, mean, per-pixel variance of the mean).
-fn render_batches(scene_path: &Path, spp_per_batch: u32) -> (Vec<Image>, Image, Vec<[f64; 3]>) {
+/// Also returns the filter's per-pixel variance factor.
+fn render_batches(scene_path: &Path, spp_per_batch: u32) -> (Vec<Image>, Image, Vec<[f64; 3]>, Vec<f64>) {
     let mut scene = load_scene(scene_path, &[]).unwrap_or_else(|e| panic!("{}", e));
     scene.integrator.moment = true;
+    let factor = variance_factor(&scene.film.filter, scene.film.crop_size.0 as usize, scene.film.crop_size.1 as usize);
     let cancel = AtomicBool::new(false);
     let mut batches = Vec::new();
     let mut m2_sum: Vec<[f64; 3]> = Vec::new();
@@ -142,9 +168,10 @@ fn render_batches(scene_path: &Path, spp_per_batch: u32) -> (Vec<Image>, Image, 
     let var: Vec<[f64; 3]> = mean
         .iter()
         .zip(&m2_sum)
-        .map(|(m, m2)| [0, 1, 2].map(|c| ((m2[c] - m[c] * m[c]).max(0.0)) / total_spp))
+        .zip(&factor)
+        .map(|((m, m2), f)| [0, 1, 2].map(|c| ((m2[c] - m[c] * m[c]).max(0.0)) * f / total_spp))
         .collect();
-    (batches, Image { w, h, mean }, var)
+    (batches, Image { w, h, mean }, var, factor)
 }
 
 fn write_failure(name: &str, img: &Image, z: &[[f64; 3]]) -> PathBuf {
@@ -169,10 +196,14 @@ fn check_scene(name: &str, spp_per_batch: u32) {
     let (vr, vg, vb) = (ch("var.R"), ch("var.G"), ch("var.B"));
     let nc = r.channels.len();
     let ref_mean: Vec<[f64; 3]> = r.data.chunks(nc).map(|p| [p[ir] as f64, p[ig] as f64, p[ib] as f64]).collect();
-    let ref_var: Vec<[f64; 3]> =
-        r.data.chunks(nc).map(|p| [p[vr] as f64 / spp_ref, p[vg] as f64 / spp_ref, p[vb] as f64 / spp_ref]).collect();
-
-    let (batches, ours, our_var) = render_batches(&root().join("scenes").join(format!("{}.xml", name)), spp_per_batch);
+    let (batches, ours, our_var, factor) =
+        render_batches(&root().join("scenes").join(format!("{}.xml", name)), spp_per_batch);
+    let ref_var: Vec<[f64; 3]> = r
+        .data
+        .chunks(nc)
+        .zip(&factor)
+        .map(|(p, f)| [p[vr] as f64 * f / spp_ref, p[vg] as f64 * f / spp_ref, p[vb] as f64 * f / spp_ref])
+        .collect();
     assert_eq!((ours.w, ours.h), (r.width, r.height), "{}: image size differs from the reference", name);
     assert!(ours.mean.iter().all(|p| p.iter().all(|v| v.is_finite())), "{}: non-finite pixels", name);
 
