@@ -1,7 +1,8 @@
 //! Fuzzing the XML parser: valid scenes mutated (byte flips, truncation, duplicated / removed /
 //! inserted tags, random attribute values, deep nesting) must give `Ok` or `Err`, never a panic.
 //!
-//! The default run is short; for a long run: `PROPTEST_CASES=200000 cargo test --release --test fuzz_xml`.
+//! The default run is short; for a long run:
+//! `PROPTEST_CASES=1000000 FUZZ_MAX_MUTATIONS=10 cargo test --release --test fuzz_xml -- --nocapture`.
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
@@ -211,7 +212,9 @@ fn mutated_scenes_never_panic() {
     let cases: u32 = std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(6000);
     let mut runner = TestRunner::new(Config { cases, failure_persistence: None, ..Config::default() });
     let dir = data_dir();
-    let strategy = (0..SEEDS.len(), proptest::collection::vec(mutation(), 0..4), proptest::bool::ANY);
+    let max_mutations: usize = std::env::var("FUZZ_MAX_MUTATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(4);
+    let strategy =
+        (0..SEEDS.len(), proptest::collection::vec(mutation(), 0..max_mutations.max(1)), proptest::bool::ANY);
     let errors = std::cell::Cell::new(0usize);
     let oks = std::cell::Cell::new(0usize);
     runner
