@@ -1,1 +1,3 @@
 //! Statistical test helpers shared by unit and integration tests (chi-square over the sphere).
+
+pub mod chi2;
