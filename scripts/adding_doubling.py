@@ -27,7 +27,7 @@ iadpython conventions (checked in iadpython 0.5.3's source, iadpython/ad.py, and
     a = 0.99, g = 0.9), and for n != 1 (Gauss + Radau split at the critical angle) for Q >= 48.
     We therefore use Q = 24 for n = 1 and Q = 40 for n != 1, and report the change from Q = 16
     (n = 1) or Q = 32 (n != 1) as `quad_change`, an estimate of the quadrature error
-    (all < 5e-4, most < 1e-5).
+    (all < 1e-4: at most 5e-5, for g = 0.9).
 
 What a renderer should compare with: R_specular = ((n-1)/(n+1))^2 is the Fresnel reflectance at
 normal incidence; a directional light reflected by a smooth dielectric is a delta peak that a
