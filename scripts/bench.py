@@ -1,0 +1,169 @@
+#!/usr/bin/env python3
+"""Time snee against Mitsuba 3 on the same scene, resolution and sample count, and print the ratio.
+
+snee:    `cargo build --release` first (not timed), then
+         `cargo run --release -- render SCENE -o OUT/snee.exr --spp N --stats OUT/snee_stats.json`.
+         Its render time is read from the stats file (keys `seconds`, `spp`, `samples_per_second`);
+         the process's wall time (scene loading, BVH build, EXR writing included) is shown too.
+Mitsuba: variant llvm_ad_rgb (falls back to scalar_rgb), the same scene file and spp, rendered with
+         `mi.render` once as a warm-up so that the LLVM JIT compilation of the kernels is EXCLUDED
+         from the timing, then rendered again (another seed) and timed until the image is in memory.
+         Scene loading is excluded as well. Large sample counts are rendered in passes of at most
+         ~4M samples (the wavefront would not fit in memory otherwise), exactly as in
+         make_references.py; the pass loop is part of the timing.
+Both use every core of the machine. The ratio printed is snee seconds / Mitsuba seconds
+(< 1: snee is faster). The mean pixel value of both images is printed as a sanity check (they
+should agree up to noise), and everything is written to OUT/bench.json.
+
+Usage:
+  python3 scripts/bench.py                                  # scenes/default.xml at 64 spp
+  python3 scripts/bench.py scenes/cornell_box.xml --spp 256
+  python3 scripts/bench.py scenes/default.xml --snee target/release/snee   # a prebuilt binary
+"""
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+LLVM_CANDIDATES = ["/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so",
+                   "/usr/lib/x86_64-linux-gnu/libLLVM-15.so", "/usr/lib/x86_64-linux-gnu/libLLVM-14.so"]
+MAX_SAMPLES_PER_PASS = 1 << 22
+
+
+def run_snee(args, scene, out_dir):
+    exr = os.path.join(out_dir, "snee.exr")
+    stats_path = os.path.join(out_dir, "snee_stats.json")
+    if os.path.exists(stats_path):
+        os.remove(stats_path)
+    if args.snee:
+        cmd = [args.snee]
+    else:
+        print("building snee (cargo build --release, not timed) ...", flush=True)
+        subprocess.run(["cargo", "build", "--release"], cwd=ROOT, check=True)
+        cmd = ["cargo", "run", "--release", "--quiet", "--"]
+    cmd += ["render", scene, "-o", exr, "--spp", str(args.spp), "--stats", stats_path]
+    print("running:", " ".join(shlex.quote(c) for c in cmd), flush=True)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=ROOT)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        sys.exit(f"snee failed with exit code {proc.returncode}")
+    with open(stats_path) as fh:
+        stats = json.load(fh)
+    for key in ("seconds", "spp", "samples_per_second"):
+        if key not in stats:
+            sys.exit(f"{stats_path}: missing key {key!r} (has {sorted(stats)})")
+    if int(stats["spp"]) != args.spp:
+        print(f"warning: snee rendered {stats['spp']} spp, asked for {args.spp}", file=sys.stderr)
+    return dict(seconds=float(stats["seconds"]), wall_seconds=wall, spp=int(stats["spp"]),
+                samples_per_second=float(stats["samples_per_second"]), image=exr, stats=stats)
+
+
+def setup_mitsuba(variant):
+    if "llvm" in variant and "DRJIT_LIBLLVM_PATH" not in os.environ:
+        for cand in LLVM_CANDIDATES:
+            if os.path.exists(cand):
+                os.environ["DRJIT_LIBLLVM_PATH"] = cand
+                break
+    import mitsuba as mi
+    try:
+        mi.set_variant(variant)
+    except Exception as err:  # noqa: BLE001 - no LLVM: fall back
+        print(f"warning: variant {variant} unavailable ({err}); using scalar_rgb", file=sys.stderr)
+        variant = "scalar_rgb"
+        mi.set_variant(variant)
+    return mi, variant
+
+
+def mitsuba_render(mi, scene, spp, seed):
+    """Render `spp` samples in passes; returns the image as a numpy array (H, W, C)."""
+    w, h = scene.sensors()[0].film().crop_size()
+    pass_spp = max(1, min(spp, MAX_SAMPLES_PER_PASS // (w * h)))
+    acc, done, k = None, 0, 0
+    while done < spp:
+        n = min(pass_spp, spp - done)
+        img = np.array(mi.render(scene, spp=n, seed=seed * 10007 + k), dtype=np.float64)
+        acc = img * n if acc is None else acc + img * n
+        done += n
+        k += 1
+    return acc / spp
+
+
+def run_mitsuba(args, scene_path, out_dir):
+    mi, variant = setup_mitsuba(args.variant)
+    scene = mi.load_file(scene_path)
+    w, h = scene.sensors()[0].film().crop_size()
+    t0 = time.perf_counter()
+    mitsuba_render(mi, scene, min(args.spp, max(1, MAX_SAMPLES_PER_PASS // (w * h))), seed=1)
+    warmup = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    img = mitsuba_render(mi, scene, args.spp, seed=2)
+    seconds = time.perf_counter() - t0
+    exr = os.path.join(out_dir, "mitsuba.exr")
+    mi.Bitmap(img[..., :3].astype(np.float32)).write(exr)
+    return dict(seconds=seconds, warmup_seconds=warmup, spp=args.spp, variant=variant,
+                samples_per_second=w * h * args.spp / seconds, image=exr, width=w, height=h,
+                mitsuba_version=mi.__version__), mi
+
+
+def mean_rgb(mi, path):
+    bmp = mi.Bitmap(path)
+    names = [bmp.struct_()[i].name for i in range(bmp.channel_count())]
+    arr = np.array(bmp, dtype=np.float64)
+    idx = [names.index(c) for c in ("R", "G", "B")] if all(c in names for c in "RGB") else [0, 1, 2]
+    return arr[..., idx].mean(axis=(0, 1))
+
+
+def main():
+    ap = argparse.ArgumentParser(description="Time snee vs Mitsuba 3 (same scene, resolution, spp).",
+                                 epilog="Mitsuba's LLVM JIT compile time is excluded (warm-up run).")
+    ap.add_argument("scene", nargs="?", default=os.path.join(ROOT, "scenes", "default.xml"),
+                    help="scene file (default: scenes/default.xml)")
+    ap.add_argument("--spp", type=int, default=64, help="samples per pixel (default 64)")
+    ap.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variant (default llvm_ad_rgb)")
+    ap.add_argument("--snee", default=None,
+                    help="path of a built snee binary (default: cargo run --release --)")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench"),
+                    help="output folder for images and bench.json (default: out/bench)")
+    ap.add_argument("--skip-snee", action="store_true", help="only time Mitsuba")
+    args = ap.parse_args()
+
+    scene = os.path.abspath(args.scene)
+    out_dir = os.path.abspath(os.path.join(args.out, os.path.splitext(os.path.basename(scene))[0]))
+    os.makedirs(out_dir, exist_ok=True)
+
+    snee = None if args.skip_snee else run_snee(args, scene, out_dir)
+    mits, mi = run_mitsuba(args, scene, out_dir)
+
+    px = mits["width"] * mits["height"]
+    print(f"\nscene {os.path.relpath(scene, ROOT)}: {mits['width']}x{mits['height']}, "
+          f"{args.spp} spp ({px * args.spp / 1e6:.2f} M samples)")
+    print(f"  {'':8s} {'seconds':>9s} {'Msamples/s':>11s}  mean RGB")
+    m_mean = mean_rgb(mi, mits["image"])
+    print(f"  {'mitsuba':8s} {mits['seconds']:9.3f} {mits['samples_per_second'] / 1e6:11.3f}  "
+          f"{np.round(m_mean, 4).tolist()}  ({mits['variant']}, JIT warm-up "
+          f"{mits['warmup_seconds']:.2f} s excluded)")
+    result = dict(scene=os.path.relpath(scene, ROOT), spp=args.spp, mitsuba=mits)
+    if snee is not None:
+        s_mean = mean_rgb(mi, snee["image"])
+        print(f"  {'snee':8s} {snee['seconds']:9.3f} {snee['samples_per_second'] / 1e6:11.3f}  "
+              f"{np.round(s_mean, 4).tolist()}  (process wall time {snee['wall_seconds']:.2f} s)")
+        ratio = snee["seconds"] / mits["seconds"]
+        print(f"  time ratio snee / mitsuba = {ratio:.3f}  "
+              f"({'snee' if ratio < 1 else 'mitsuba'} is {max(ratio, 1 / ratio):.2f}x faster)")
+        result.update(snee=snee, ratio_seconds=ratio)
+    path = os.path.join(out_dir, "bench.json")
+    with open(path, "w") as fh:
+        json.dump(result, fh, indent=2, default=str)
+        fh.write("\n")
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
