@@ -170,15 +170,16 @@ fn run(cli: Cli) -> anyhow::Result<()> {
 }
 
 fn write_output(path: &Path, out: &snee::render::RenderOutput, png: bool) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating the folder {}", dir.display()))?;
+    }
     let names: Vec<&str> = out.channels.iter().map(|s| s.as_str()).collect();
-    snee::io::write::write_exr(path, out.width, out.height, &names, &out.data)
-        .with_context(|| format!("writing {}", path.display()))?;
+    snee::io::write::write_exr(path, out.width, out.height, &names, &out.data)?;
     if png {
         let n = out.channels.len();
         let rgb: Vec<f32> = out.data.chunks(n).flat_map(|p| [p[0], p[1], p[2]]).collect();
         let png_path = path.with_extension("png");
-        snee::io::write::write_png(&png_path, out.width, out.height, &rgb)
-            .with_context(|| format!("writing {}", png_path.display()))?;
+        snee::io::write::write_png(&png_path, out.width, out.height, &rgb)?;
     }
     Ok(())
 }

@@ -31,7 +31,9 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
     let mut prev_bsdf_pdf = 1.0f32;
     let mut prev_bsdf_delta = true;
 
-    let mut valid = false;
+    // Mitsuba's `valid_ray`: a path that never scatters off a non-null surface (and sees no
+    // environment) contributes nothing, not even the emission of null surfaces it crossed.
+    let mut valid = !desc.hide_emitters && scene.environment.is_some();
     if max_depth == 0 {
         return (result, valid);
     }
@@ -73,7 +75,6 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
             }
         }
         let Some(si) = si else { break };
-        valid |= depth == 0;
         if depth + 1 >= max_depth {
             break;
         }
@@ -99,6 +100,7 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
         let Some((bs, bsdf_weight)) = bsdf.sample(&ctx, &si, s1, s2) else { break };
         beta *= bsdf_weight;
         eta *= bs.eta;
+        valid |= bs.sampled_type & flags::NULL == 0;
         let wo_world = si.to_world(bs.wo);
         ray = si.spawn_ray(wo_world);
         prev_p = si.p;
@@ -119,5 +121,5 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
             beta /= q;
         }
     }
-    (result, valid)
+    (if valid { result } else { Spectrum::ZERO }, valid)
 }
