@@ -195,7 +195,12 @@ def filter_1d(scene):
     radius = rf.radius()
 
     def w(x):
-        return np.array(rf.eval(mi.Float(np.asarray(x, dtype=np.float64).ravel()))).reshape(np.shape(x))
+        flat = np.asarray(x, dtype=np.float64).ravel()
+        if mi.variant().startswith("scalar"):
+            vals = np.array([rf.eval(float(v)) for v in flat])
+        else:
+            vals = np.array(rf.eval(mi.Float(flat)))
+        return vals.reshape(np.shape(x))
 
     return rf, radius, w
 
