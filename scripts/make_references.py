@@ -79,6 +79,7 @@ DEFAULT_SPP = {
 }
 FALLBACK_SPP = 4096
 MAX_SAMPLES_PER_PASS = 1 << 22
+BLOCK = 8  # block size of the block-averaged z statistics printed by --check
 
 SRGB_TO_XYZ_Y = np.array([0.212671, 0.715160, 0.072169])  # row Y of Mitsuba's srgb_to_xyz
 
@@ -194,7 +195,12 @@ def filter_1d(scene):
     radius = rf.radius()
 
     def w(x):
-        return np.array(rf.eval(mi.Float(np.asarray(x, dtype=np.float64).ravel()))).reshape(np.shape(x))
+        flat = np.asarray(x, dtype=np.float64).ravel()
+        if mi.variant().startswith("scalar"):
+            vals = np.array([rf.eval(float(v)) for v in flat])
+        else:
+            vals = np.array(rf.eval(mi.Float(flat)))
+        return vals.reshape(np.shape(x))
 
     return rf, radius, w
 
@@ -321,10 +327,31 @@ def zscore_check(path, spp, ref_var=None):
                frac_gt3=float(np.mean(np.abs(z) > 3)), max_abs=float(np.abs(z).max()),
                zcrit=float(zcrit), n_fail=int(np.sum(np.abs(z) > zcrit)),
                zero_var=int(np.sum(~mask)))
-    print(f"  {res['scene']:26s} spp={spp:5d} n={n:6d}  mean z={res['mean']:+.3f}  "
+    print(f"  {res['scene']:26s} spp={spp:5d} pixels: n={n:6d}  mean z={res['mean']:+.3f}  "
           f"std z={res['std']:.3f}  |z|>2: {100 * res['frac_gt2']:.2f}% (4.55)  "
           f"|z|>3: {100 * res['frac_gt3']:.3f}% (0.27)  max|z|={res['max_abs']:.2f}  "
           f"Sidak crit {zcrit:.2f}: {res['n_fail']} over  ({res['zero_var']} zero-var)")
+
+    # Block test: means over BxB pixel blocks. For blocks much larger than the filter, every
+    # sample's weights over the block's pixels sum to ~1/spp, so Var[block mean] ~ mean(var)/(spp B^2)
+    # (filter factor ~1, not f: neighbouring pixels are correlated through shared samples).
+    bs = BLOCK
+    h, w = a.shape[0] // bs * bs, a.shape[1] // bs * bs
+
+    def blocks(x):
+        return x[:h, :w].reshape(h // bs, bs, w // bs, bs, -1).mean(axis=(1, 3))
+
+    bvar = blocks(var) / (spp * bs * bs)
+    bmask = bvar > 0
+    zb = (blocks(a) - blocks(b))[bmask] / np.sqrt(2.0 * bvar[bmask])
+    nb = zb.size
+    zcrit_b = norm.isf((1.0 - (1.0 - 0.01) ** (1.0 / max(nb, 1))) / 2)
+    res.update(block=bs, block_n=int(nb), block_std=float(zb.std()),
+               block_max_abs=float(np.abs(zb).max()), block_zcrit=float(zcrit_b),
+               block_n_fail=int(np.sum(np.abs(zb) > zcrit_b)))
+    print(f"  {'':26s} {'':9s} {bs}x{bs} blocks: n={nb:5d}  mean z={zb.mean():+.3f}  "
+          f"std z={zb.std():.3f}  max|z|={res['block_max_abs']:.2f}  "
+          f"Sidak crit {zcrit_b:.2f}: {res['block_n_fail']} over")
     return res
 
 
