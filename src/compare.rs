@@ -78,7 +78,15 @@ pub fn compare(a: &Bitmap, b: &Bitmap) -> Result<CompareResult, String> {
         mb[c] /= n;
     }
     let ratio = (ma[0] + ma[1] + ma[2]) / (mb[0] + mb[1] + mb[2]);
-    Ok(CompareResult { width: a.width, height: a.height, mse, rel_mse: rel_mse(&ra, &rb), mean_a: ma, mean_b: mb, ratio })
+    Ok(CompareResult {
+        width: a.width,
+        height: a.height,
+        mse,
+        rel_mse: rel_mse(&ra, &rb),
+        mean_a: ma,
+        mean_b: mb,
+        ratio,
+    })
 }
 
 /// Outcome of a per-pixel two-sample Z-test.
@@ -130,12 +138,15 @@ pub fn z_test(a: &[[f32; 3]], va: &[[f32; 3]], b: &[[f32; 3]], vb: &[[f32; 3]], 
 pub fn erfc(x: f64) -> f64 {
     let z = x.abs();
     let t = 1.0 / (1.0 + 0.5 * z);
-    let r = t * (-z * z - 1.26551223
-        + t * (1.00002368
-            + t * (0.37409196
-                + t * (0.09678418
-                    + t * (-0.18628806 + t * (0.27886807 + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
-        .exp();
+    let r = t
+        * (-z * z - 1.26551223
+            + t * (1.00002368
+                + t * (0.37409196
+                    + t * (0.09678418
+                        + t * (-0.18628806
+                            + t * (0.27886807
+                                + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+            .exp();
     if x >= 0.0 {
         r
     } else {

@@ -99,16 +99,38 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
     if b.is_empty() {
         let _ = writeln!(text, "bounds: empty");
     } else {
-        let _ = writeln!(text, "bounds: [{:.4}, {:.4}, {:.4}] .. [{:.4}, {:.4}, {:.4}]", b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z);
+        let _ = writeln!(
+            text,
+            "bounds: [{:.4}, {:.4}, {:.4}] .. [{:.4}, {:.4}, {:.4}]",
+            b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z
+        );
     }
     let _ = writeln!(text, "media: {}", scene.media.len());
     for m in &scene.media {
-        let _ = writeln!(text, "  {:?} sigma_t={:?} albedo={:?} phase={:?}", m.id, m.sigma_t.to_array(), m.albedo.to_array(), m.phase);
+        let _ = writeln!(
+            text,
+            "  {:?} sigma_t={:?} albedo={:?} phase={:?}",
+            m.id,
+            m.sigma_t.to_array(),
+            m.albedo.to_array(),
+            m.phase
+        );
     }
     let names: Vec<&str> = scene.emitters.iter().map(emitter_name).collect();
     let _ = writeln!(text, "emitters: {} [{}]", names.len(), names.join(", "));
-    let _ = writeln!(text, "film: {}x{} (crop {}x{} at {},{})", film.width, film.height, film.crop_size.0, film.crop_size.1, film.crop_offset.0, film.crop_offset.1);
+    let _ = writeln!(
+        text,
+        "film: {}x{} (crop {}x{} at {},{})",
+        film.width, film.height, film.crop_size.0, film.crop_size.1, film.crop_offset.0, film.crop_offset.1
+    );
     let _ = writeln!(text, "spp: {} ({})", sampler.sample_count, sampler_kind);
-    let _ = writeln!(text, "integrator: {:?} max_depth={} rr_depth={}{}", integ.kind, integ.max_depth, integ.rr_depth, if integ.moment { " (moment)" } else { "" });
+    let _ = writeln!(
+        text,
+        "integrator: {:?} max_depth={} rr_depth={}{}",
+        integ.kind,
+        integ.max_depth,
+        integ.rr_depth,
+        if integ.moment { " (moment)" } else { "" }
+    );
     Summary { json, text }
 }

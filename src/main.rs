@@ -13,7 +13,11 @@ use std::sync::Arc;
 const DEFAULT_SCENE: &str = "scenes/default.xml";
 
 #[derive(Parser)]
-#[command(name = "snee", version, about = "Renders Mitsuba 3 scenes: translucent objects with Subdivision Next-Event Estimation")]
+#[command(
+    name = "snee",
+    version,
+    about = "Renders Mitsuba 3 scenes: translucent objects with Subdivision Next-Event Estimation"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -139,7 +143,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             write_output(&output, &out, png)?;
             let st = out.stats.to_json();
             if let Some(p) = stats {
-                std::fs::write(&p, serde_json::to_string_pretty(&st)?).with_context(|| format!("writing {}", p.display()))?;
+                std::fs::write(&p, serde_json::to_string_pretty(&st)?)
+                    .with_context(|| format!("writing {}", p.display()))?;
             }
             if !quiet {
                 eprintln!(

@@ -10,8 +10,8 @@ use crate::integrator::{path, volpath, IntegratorKind};
 use crate::math::Vec2;
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
-use crate::sensor::image_block::ImageBlock;
 use crate::sensor::film::PixelFormat;
+use crate::sensor::image_block::ImageBlock;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
@@ -152,7 +152,10 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
                 for x in x0..x0 + w as i32 {
                     // Unique per film pixel (the border may lie outside the film: offset it).
                     let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
-                    let mut sampler = Sampler::new(opts.seed, pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(first_sample as u64));
+                    let mut sampler = Sampler::new(
+                        opts.seed,
+                        pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(first_sample as u64),
+                    );
                     for _ in 0..pass_spp {
                         let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
                         let aperture = sampler.next_2d();

@@ -10,6 +10,12 @@
 //!   pixel filter's correlations), the reference's from its variance channel;
 //! - the whole image (same batch method), which is what catches a ~1 % bias.
 //!
+//! Per-pixel tests are fragile where rare, very bright samples dominate (caustics of the sun
+//! through glass): even two Mitsuba renders fail a per-pixel Šidák test there (0.2–0.4 % of
+//! pixel-channels at 256 spp, measured by `scripts/make_references.py --check`). Those scenes get
+//! the block and image tests only. Every variance gets a floor of (1e-4 · reference)² for float
+//! rounding (Mitsuba accumulates in float32), far below any bias worth detecting.
+//!
 //! On failure the render and a per-pixel z-score image are written to `target/test-output/`.
 
 use snee::compare::erfc;
@@ -22,6 +28,8 @@ use std::sync::atomic::AtomicBool;
 const ALPHA: f64 = 0.01;
 const BATCHES: usize = 16;
 const BLOCK: usize = 8;
+/// Relative precision floor added to every variance (see the module docs).
+const PRECISION: f64 = 1e-4;
 
 struct Image {
     w: usize,
@@ -42,8 +50,14 @@ fn t_p_value(t: f64, dof: f64) -> f64 {
 fn ln_gamma(x: f64) -> f64 {
     // Lanczos approximation (g = 7, n = 9).
     const C: [f64; 9] = [
-        0.999_999_999_999_809_9, 676.520_368_121_885_1, -1_259.139_216_722_402_8, 771.323_428_777_653_1,
-        -176.615_029_162_140_6, 12.507_343_278_686_905, -0.138_571_095_265_720_12, 9.984_369_578_019_572e-6,
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
         1.505_632_735_149_311_6e-7,
     ];
     let x = x - 1.0;
@@ -138,7 +152,8 @@ fn render_batches(scene_path: &Path, spp_per_batch: u32) -> (Vec<Image>, Image, 
     let mut batches = Vec::new();
     let mut m2_sum: Vec<[f64; 3]> = Vec::new();
     for b in 0..BATCHES {
-        let opts = RenderOptions { spp: Some(spp_per_batch), seed: 1000 + b as u64, time_budget: None, progress: false };
+        let opts =
+            RenderOptions { spp: Some(spp_per_batch), seed: 1000 + b as u64, time_budget: None, progress: false };
         let out = render(&scene, &opts, &cancel);
         let n = out.channels.len();
         let m2i = out.channels.iter().position(|c| c == "m2.R").expect("moment channels");
@@ -184,7 +199,15 @@ fn write_failure(name: &str, img: &Image, z: &[[f64; 3]]) -> PathBuf {
     dir
 }
 
-fn check_scene(name: &str, spp_per_batch: u32) {
+fn check_scene(name: &str, spp_per_batch: u32, per_pixel: bool) {
+    match compare_scene(name, spp_per_batch, per_pixel, 1.0) {
+        Ok(msg) => eprintln!("{}", msg),
+        Err(msg) => panic!("{}", msg),
+    }
+}
+
+/// Render `name` (our image multiplied by `bias`, 1 for the real test) and run the three tests.
+fn compare_scene(name: &str, spp_per_batch: u32, per_pixel: bool, bias: f64) -> Result<String, String> {
     let ref_exr = root().join("reference").join(format!("{}.exr", name));
     let ref_json = root().join("reference").join(format!("{}.json", name));
     let meta: serde_json::Value =
@@ -196,8 +219,13 @@ fn check_scene(name: &str, spp_per_batch: u32) {
     let (vr, vg, vb) = (ch("var.R"), ch("var.G"), ch("var.B"));
     let nc = r.channels.len();
     let ref_mean: Vec<[f64; 3]> = r.data.chunks(nc).map(|p| [p[ir] as f64, p[ig] as f64, p[ib] as f64]).collect();
-    let (batches, ours, our_var, factor) =
+    let (mut batches, mut ours, our_var, factor) =
         render_batches(&root().join("scenes").join(format!("{}.xml", name)), spp_per_batch);
+    for img in batches.iter_mut().chain(std::iter::once(&mut ours)) {
+        for p in img.mean.iter_mut() {
+            *p = p.map(|v| v * bias);
+        }
+    }
     let ref_var: Vec<[f64; 3]> = r
         .data
         .chunks(nc)
@@ -214,7 +242,7 @@ fn check_scene(name: &str, spp_per_batch: u32) {
     let mut worst = String::new();
     for i in 0..n_pix {
         for c in 0..3 {
-            let var = our_var[i][c] + ref_var[i][c];
+            let var = our_var[i][c] + ref_var[i][c] + (PRECISION * ref_mean[i][c]).powi(2);
             let d = ours.mean[i][c] - ref_mean[i][c];
             let p = if var > 0.0 {
                 z[i][c] = d / var.sqrt();
@@ -227,7 +255,15 @@ fn check_scene(name: &str, spp_per_batch: u32) {
             };
             if p < min_p {
                 min_p = p;
-                worst = format!("pixel ({}, {}) channel {}: ours {} ref {} z {:.2}", i % ours.w, i / ours.w, c, ours.mean[i][c], ref_mean[i][c], z[i][c]);
+                worst = format!(
+                    "pixel ({}, {}) channel {}: ours {} ref {} z {:.2}",
+                    i % ours.w,
+                    i / ours.w,
+                    c,
+                    ours.mean[i][c],
+                    ref_mean[i][c],
+                    z[i][c]
+                );
             }
         }
     }
@@ -260,7 +296,7 @@ fn check_scene(name: &str, spp_per_batch: u32) {
             let var_ours = s2 / BATCHES as f64;
             let var_ref = px.iter().map(|&i| ref_var[i][c]).sum::<f64>() / (px.len() * px.len()) as f64;
             let d = m - avg(&ref_mean);
-            let var = var_ours + var_ref;
+            let var = var_ours + var_ref + (PRECISION * avg(&ref_mean)).powi(2);
             let p = if var > 0.0 {
                 t_p_value(d / var.sqrt(), (BATCHES - 1) as f64)
             } else if d.abs() > 1e-6 {
@@ -283,9 +319,10 @@ fn check_scene(name: &str, spp_per_batch: u32) {
             }
         }
     }
-    if min_p < level || region_fail.is_some() {
+    let pixel_fail = per_pixel && min_p < level;
+    if pixel_fail || region_fail.is_some() {
         let dir = write_failure(name, &ours, &z);
-        panic!(
+        return Err(format!(
             "{}: differs from the Mitsuba reference.\n  per-pixel: min p = {:.2e} (level {:.2e}); worst {}\n  regions: {}\n  images in {}",
             name,
             min_p,
@@ -293,9 +330,27 @@ fn check_scene(name: &str, spp_per_batch: u32) {
             worst,
             region_fail.unwrap_or_else(|| "ok".into()),
             dir.display()
-        );
+        ));
     }
-    eprintln!("{}: per-pixel min p = {:.3e} (level {:.2e}); blocks and image mean pass", name, min_p, level);
+    Ok(format!(
+        "{}: per-pixel min p = {:.3e} (level {:.2e}, {}); blocks and image mean pass",
+        name,
+        min_p,
+        level,
+        if per_pixel { "tested" } else { "not tested: caustics" }
+    ))
+}
+
+/// The tests can fail: a 1 % brightness bias is caught on the Cornell box and on the glass scene
+/// (where only the block and image tests run).
+#[test]
+fn one_percent_bias_is_detected() {
+    for (name, spp, per_pixel) in [("cornell_box", 64, true), ("rough_glass_ggx", 16, false)] {
+        for bias in [0.99, 1.01] {
+            let r = compare_scene(name, spp, per_pixel, bias);
+            assert!(r.is_err(), "{} with a {:+}% bias passed: {:?}", name, (bias - 1.0) * 100.0, r);
+        }
+    }
 }
 
 #[test]
@@ -303,4 +358,34 @@ fn t_distribution_sanity() {
     // t = 2.131 with 15 dof has a two-sided p of 0.05.
     assert!((t_p_value(2.131, 15.0) - 0.05).abs() < 5e-4);
     assert!((t_p_value(0.0, 15.0) - 1.0).abs() < 1e-9);
+}
+
+// One test per reference scene. Each renders 16 batches; spp per batch keeps every test to a few seconds.
+#[test]
+fn cornell_box() {
+    check_scene("cornell_box", 64, true);
+}
+#[test]
+fn default_scene() {
+    check_scene("default", 8, false);
+}
+#[test]
+fn directional_area() {
+    check_scene("directional_area", 64, true);
+}
+#[test]
+fn glass_envmap() {
+    check_scene("glass_envmap", 16, false);
+}
+#[test]
+fn rough_glass_beckmann() {
+    check_scene("rough_glass_beckmann", 16, false);
+}
+#[test]
+fn rough_glass_ggx() {
+    check_scene("rough_glass_ggx", 16, false);
+}
+#[test]
+fn spot_point() {
+    check_scene("spot_point", 64, true);
 }

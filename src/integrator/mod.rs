@@ -55,12 +55,13 @@ impl IntegratorDesc {
             "volpath" => IntegratorKind::Volpath,
             "volpathmis" => IntegratorKind::Volpathmis,
             "volpath_snee" => IntegratorKind::VolpathSnee,
-            other => {
-                return Err(Error::at(
-                    &obj.pos,
-                    format!("integrator \"{}\" is not supported (supported: path, volpath, volpathmis, volpath_snee, moment)", other),
-                ))
-            }
+            other => return Err(Error::at(
+                &obj.pos,
+                format!(
+                    "integrator \"{}\" is not supported (supported: path, volpath, volpathmis, volpath_snee, moment)",
+                    other
+                ),
+            )),
         };
         let max_depth = props.int("max_depth", -1)?;
         if max_depth < -1 {
@@ -73,6 +74,12 @@ impl IntegratorDesc {
         let hide_emitters = props.bool("hide_emitters", false)?;
         props.finish()?;
         let clamp = |v: i64| v.clamp(-1, i32::MAX as i64) as i32;
-        Ok(IntegratorDesc { kind, max_depth: clamp(max_depth), rr_depth: clamp(rr_depth), hide_emitters, moment: false })
+        Ok(IntegratorDesc {
+            kind,
+            max_depth: clamp(max_depth),
+            rr_depth: clamp(rr_depth),
+            hide_emitters,
+            moment: false,
+        })
     }
 }

@@ -97,7 +97,11 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
         // ---- BSDF sampling ----
         let s1 = sampler.next_1d();
         let s2 = sampler.next_2d();
-        let Some((bs, bsdf_weight)) = bsdf.sample(&ctx, &si, s1, s2) else { break };
+        let Some((bs, bsdf_weight)) = bsdf.sample(&ctx, &si, s1, s2) else {
+            // A failed (zero-weight) sample of a non-null BSDF still makes the path valid (Mitsuba).
+            valid |= bsdf_flags & !flags::NULL != 0;
+            break;
+        };
         beta *= bsdf_weight;
         eta *= bs.eta;
         valid |= bs.sampled_type & flags::NULL == 0;

@@ -151,7 +151,13 @@ pub fn shadow_transmittance(
 }
 
 /// Radiance along a camera ray starting in `medium`; also whether the ray is "valid" (alpha).
-pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, medium: Option<u32>, stats: &mut LocalStats) -> (Spectrum, bool) {
+pub fn li(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    ray: Ray,
+    medium: Option<u32>,
+    stats: &mut LocalStats,
+) -> (Spectrum, bool) {
     let desc = &scene.integrator;
     let max_depth = if desc.max_depth < 0 { u32::MAX } else { desc.max_depth as u32 };
     let rr_depth = desc.rr_depth as u32;
@@ -306,7 +312,10 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, medium: Option<u32>, s
         // ---- BSDF sampling ----
         let s1 = sampler.next_1d();
         let s2 = sampler.next_2d();
-        let Some((bs, weight)) = bsdf.sample(&ctx, &s, s1, s2) else { break };
+        let Some((bs, weight)) = bsdf.sample(&ctx, &s, s1, s2) else {
+            valid_ray |= bsdf.flags() & !flags::NULL != 0;
+            break;
+        };
         beta *= weight;
         eta *= bs.eta;
         let wo = s.to_world(bs.wo);

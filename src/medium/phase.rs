@@ -11,7 +11,9 @@ use crate::scene::{Error, Result};
 pub enum Phase {
     Isotropic,
     /// Henyey-Greenstein with asymmetry `g` in (-1, 1).
-    Hg { g: f32 },
+    Hg {
+        g: f32,
+    },
 }
 
 impl Phase {
@@ -91,15 +93,7 @@ mod tests {
         let wi = Vec3::new(0.3, -0.4, 0.866).normalize();
         for g in [-0.9, -0.5, 0.0, 0.3, 0.8, 0.9] {
             let phase = if g == 0.0 { Phase::Isotropic } else { Phase::Hg { g } };
-            let r = chi2_sphere(
-                |_, u| Some(phase.sample(wi, u).0),
-                |wo| phase.eval(wi, wo),
-                40,
-                80,
-                400_000,
-                0.01,
-                7,
-            );
+            let r = chi2_sphere(|_, u| Some(phase.sample(wi, u).0), |wo| phase.eval(wi, wo), 40, 80, 400_000, 0.01, 7);
             assert!(r.passed, "g = {}: {}", g, r.report);
             assert!((r.pdf_integral - 1.0).abs() < 2e-3, "g = {}: ∫p = {}", g, r.pdf_integral);
         }

@@ -39,7 +39,7 @@ struct Builder<'a> {
     emitters: Vec<SceneEmitter>,
     environment: Option<(u32, ObjectPos)>,
     default_bsdf: Option<u32>,
-    null_bsdf: Option<u32>,
+    black_bsdf: Option<u32>,
 }
 
 type ObjectPos = super::SrcPos;
@@ -56,7 +56,7 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         emitters: Vec::new(),
         environment: None,
         default_bsdf: None,
-        null_bsdf: None,
+        black_bsdf: None,
     };
     let mut integrator: Option<(IntegratorDesc, ObjectPos)> = None;
     let mut sensor: Option<Sensor> = None;
@@ -65,13 +65,19 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         match obj.kind {
             PluginKind::Integrator => {
                 if let Some((_, first)) = &integrator {
-                    return Err(Error::at(&obj.pos, format!("a scene has at most one integrator (the first is at {})", first)));
+                    return Err(Error::at(
+                        &obj.pos,
+                        format!("a scene has at most one integrator (the first is at {})", first),
+                    ));
                 }
                 integrator = Some((IntegratorDesc::from_desc(&obj)?, obj.pos.clone()));
             }
             PluginKind::Sensor => {
                 if let Some(first) = &sensor_pos {
-                    return Err(Error::at(&obj.pos, format!("only one sensor is supported (the first is at {})", first)));
+                    return Err(Error::at(
+                        &obj.pos,
+                        format!("only one sensor is supported (the first is at {})", first),
+                    ));
                 }
                 if obj.plugin != "perspective" {
                     return Err(Error::at(
@@ -174,29 +180,23 @@ impl Builder<'_> {
         Ok(i)
     }
 
-    /// Mitsuba's default BSDF for a shape without one: diffuse (0.5), or null on a medium boundary.
-    fn default_bsdf(&mut self, null: bool) -> Result<u32> {
-        let slot = if null { self.null_bsdf } else { self.default_bsdf };
+    /// Mitsuba's default BSDF for a shape without one: `diffuse` with reflectance 0.5, or 0 when
+    /// the shape is an area emitter (checked against Mitsuba 3.9; media boundaries get 0.5 too).
+    fn default_bsdf(&mut self, emitter: bool) -> Result<u32> {
+        let slot = if emitter { self.black_bsdf } else { self.default_bsdf };
         if let Some(i) = slot {
             return Ok(i);
         }
-        let bsdf = if null {
-            Bsdf::Null
-        } else {
-            let pos = super::SrcPos::new("<default bsdf>", 0, 0);
-            let obj = ObjectDesc {
-                kind: PluginKind::Bsdf,
-                plugin: "diffuse".into(),
-                id: None,
-                pos: pos.clone(),
-                props: super::desc::Props::new(PluginKind::Bsdf, "diffuse", pos),
-            };
-            Bsdf::from_desc(&obj, self.resolver)?
-        };
-        self.bsdfs.push(bsdf);
+        let pos = super::SrcPos::new("<default bsdf>", 0, 0);
+        let mut props = super::desc::Props::new(PluginKind::Bsdf, "diffuse", pos.clone());
+        if emitter {
+            props.push("reflectance", super::desc::Value::Float(0.0), pos.clone())?;
+        }
+        let obj = ObjectDesc { kind: PluginKind::Bsdf, plugin: "diffuse".into(), id: None, pos, props };
+        self.bsdfs.push(Bsdf::from_desc(&obj, self.resolver)?);
         let i = (self.bsdfs.len() - 1) as u32;
-        if null {
-            self.null_bsdf = Some(i);
+        if emitter {
+            self.black_bsdf = Some(i);
         } else {
             self.default_bsdf = Some(i);
         }
@@ -229,7 +229,8 @@ impl Builder<'_> {
             return Err(props.error("to_world", "to_world is singular or not finite"));
         }
         let flip_normals = props.bool("flip_normals", false)?;
-        let mesh = |data: MeshData, face_normals: bool| Geometry::Mesh(Mesh::new(data, &to_world, face_normals, flip_normals));
+        let mesh =
+            |data: MeshData, face_normals: bool| Geometry::Mesh(Mesh::new(data, &to_world, face_normals, flip_normals));
         let geometry = match obj.plugin.as_str() {
             "obj" | "ply" | "serialized" => {
                 let Some(name) = props.string_opt("filename")? else {
@@ -287,12 +288,13 @@ impl Builder<'_> {
             Some(m) => Some(self.medium(&m)?),
             None => None,
         };
+        let emitter_desc = props.object_of(PluginKind::Emitter)?;
         let bsdf = match props.object_of(PluginKind::Bsdf)? {
             Some(b) => self.bsdf(&b)?,
-            None => self.default_bsdf(interior.is_some() || exterior.is_some())?,
+            None => self.default_bsdf(emitter_desc.is_some())?,
         };
         let mut emitter = None;
-        if let Some(e) = props.object_of(PluginKind::Emitter)? {
+        if let Some(e) = emitter_desc {
             if e.plugin != "area" {
                 return Err(Error::at(
                     &e.pos,
@@ -300,10 +302,8 @@ impl Builder<'_> {
                 ));
             }
             let ep = &e.props;
-            let Some(arg) = ep.texture_opt("radiance")? else {
-                return Err(Error::at(&e.pos, "area emitter requires a \"radiance\""));
-            };
-            let radiance = Texture::from_arg(&arg, self.resolver)?;
+            // Mitsuba's default radiance is a uniform 1 (untinted).
+            let radiance = Texture::from_arg(&ep.texture("radiance", Vec3::ONE)?, self.resolver)?;
             ep.finish()?;
             self.emitters.push(SceneEmitter::Area { shape: index, radiance });
             emitter = Some((self.emitters.len() - 1) as u32);
@@ -312,8 +312,15 @@ impl Builder<'_> {
             return Err(Error::at(&s.pos, format!("sensor \"{}\" inside a shape is not supported yet", s.plugin)));
         }
         props.finish()?;
-        self.shapes.push(Shape { geometry, plugin: obj.plugin.clone(), id: obj.id.clone(), bsdf, emitter, interior, exterior });
+        self.shapes.push(Shape {
+            geometry,
+            plugin: obj.plugin.clone(),
+            id: obj.id.clone(),
+            bsdf,
+            emitter,
+            interior,
+            exterior,
+        });
         Ok(())
     }
 }
-

@@ -151,7 +151,13 @@ pub enum TexArg {
 
 impl Props {
     pub fn new(owner_kind: PluginKind, owner_plugin: &str, owner_pos: SrcPos) -> Props {
-        Props { owner_kind, owner_plugin: owner_plugin.to_string(), owner_pos, items: Vec::new(), queried: RefCell::new(Vec::new()) }
+        Props {
+            owner_kind,
+            owner_plugin: owner_plugin.to_string(),
+            owner_pos,
+            items: Vec::new(),
+            queried: RefCell::new(Vec::new()),
+        }
     }
 
     /// Add a property. A second property with the same name is an error (as in Mitsuba).
@@ -394,7 +400,10 @@ impl Props {
             Value::Integer(v) => Ok(*v as f32),
             Value::String(s) => lookup_ior(s).ok_or_else(|| {
                 let names: Vec<&str> = IOR_TABLE.iter().map(|(n, _)| *n).collect();
-                Error::at(&p.pos, format!("unknown IOR name \"{}\" (expected a number or one of: {})", s, names.join(", ")))
+                Error::at(
+                    &p.pos,
+                    format!("unknown IOR name \"{}\" (expected a number or one of: {})", s, names.join(", ")),
+                )
             }),
             _ => Err(self.type_error(p, "float or IOR name")),
         }

@@ -19,7 +19,10 @@ use crate::texture::Texture;
 #[derive(Clone, Debug)]
 pub enum SceneEmitter {
     /// Mitsuba's `area` emitter: emits `radiance` from the front side of shape `shape`.
-    Area { shape: u32, radiance: Texture },
+    Area {
+        shape: u32,
+        radiance: Texture,
+    },
     Other(Emitter),
 }
 
@@ -71,7 +74,13 @@ impl Scene {
     /// Pick an emitter uniformly and sample a direction towards it from `ref_p`.
     /// Returns (ds, weight) where weight = L·(geometry)/pdf including the selection probability;
     /// zero weight when the sample failed or (with `test_visibility`) is occluded.
-    pub fn sample_emitter_direction(&self, ref_p: Vec3, ref_n: Option<Vec3>, sample: Vec2, test_visibility: bool) -> (DirectionSample, Spectrum) {
+    pub fn sample_emitter_direction(
+        &self,
+        ref_p: Vec3,
+        ref_n: Option<Vec3>,
+        sample: Vec2,
+        test_visibility: bool,
+    ) -> (DirectionSample, Spectrum) {
         let n = self.emitters.len();
         if n == 0 {
             return (DirectionSample::default(), Spectrum::ZERO);
@@ -91,11 +100,8 @@ impl Scene {
                 Some(nrm) => crate::interaction::offset_origin(ref_p, nrm, ds.d),
                 None => ref_p,
             };
-            let ray = if ds.dist.is_finite() {
-                crate::interaction::spawn_ray_between(o, ds.p)
-            } else {
-                Ray::new(o, ds.d)
-            };
+            let ray =
+                if ds.dist.is_finite() { crate::interaction::spawn_ray_between(o, ds.p) } else { Ray::new(o, ds.d) };
             if self.ray_test(&ray) {
                 return (ds, Spectrum::ZERO);
             }

@@ -12,7 +12,7 @@ use glam::Vec3A;
 use obvhs::aabb::Aabb as BvhAabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray as BvhRay, RayHit};
-use obvhs::{BvhBuildParams, Boundable};
+use obvhs::{Boundable, BvhBuildParams};
 use std::time::Duration;
 
 /// A BVH primitive: triangle `prim` of shape `shape`, or a whole analytic shape.
@@ -158,7 +158,17 @@ impl WatertightRay {
     fn new(ray: &Ray) -> Self {
         let d = ray.d;
         let a = d.abs();
-        let kz = if a.x > a.y { if a.x > a.z { 0 } else { 2 } } else if a.y > a.z { 1 } else { 2 };
+        let kz = if a.x > a.y {
+            if a.x > a.z {
+                0
+            } else {
+                2
+            }
+        } else if a.y > a.z {
+            1
+        } else {
+            2
+        };
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         if d[kz] < 0.0 {
@@ -208,4 +218,3 @@ impl WatertightRay {
         Some((t, v_ * inv_det, w * inv_det))
     }
 }
-

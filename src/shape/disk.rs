@@ -68,7 +68,16 @@ impl Disk {
         let p = self.to_world.transform_point3(local);
         let n = if self.flip_normals { -self.n } else { self.n };
         let sh_frame = Frame::from_normal(n);
-        SurfaceInteraction { t, p, n, sh_frame, uv: Self::local_uv(local), wi: sh_frame.to_local(-ray.d), shape: 0, prim: 0 }
+        SurfaceInteraction {
+            t,
+            p,
+            n,
+            sh_frame,
+            uv: Self::local_uv(local),
+            wi: sh_frame.to_local(-ray.d),
+            shape: 0,
+            prim: 0,
+        }
     }
 
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {

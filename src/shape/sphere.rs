@@ -81,7 +81,12 @@ impl Sphere {
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
         let d = warp::square_to_uniform_sphere(sample);
         let p = self.center + d * self.radius;
-        PositionSample { p, n: if self.flip_normals { -d } else { d }, uv: self.local_uv(p), pdf: 1.0 / self.surface_area() }
+        PositionSample {
+            p,
+            n: if self.flip_normals { -d } else { d },
+            uv: self.local_uv(p),
+            pdf: 1.0 / self.surface_area(),
+        }
     }
 
     /// Sample a point visible from `ref_p` (Mitsuba's `Sphere::sample_direction`).

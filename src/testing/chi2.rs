@@ -120,16 +120,7 @@ pub fn chi2_sphere(
             // e²/E to the statistic; keep e ≤ 0.01 counts (0.01·√E for large E).
             let coarse = simpson_3x3(&pdf_zphi, z0, z0 + dz, p0, p0 + dphi);
             let tol_counts = 0.01 * (coarse * n).sqrt().max(1.0);
-            let v = adaptive_simpson(
-                &pdf_zphi,
-                z0,
-                z0 + dz,
-                p0,
-                p0 + dphi,
-                coarse,
-                tol_counts / n,
-                0,
-            );
+            let v = adaptive_simpson(&pdf_zphi, z0, z0 + dz, p0, p0 + dphi, coarse, tol_counts / n, 0);
             if !v.is_finite() {
                 non_finite_pdf = true;
             }
@@ -141,11 +132,7 @@ pub fn chi2_sphere(
 
     // ---- Cells: the bins plus the missing mass of failed samples ----
     let mut cells: Vec<Cell> = (0..n_bins)
-        .map(|k| Cell {
-            observed: observed[k] as f64,
-            expected: expected[k],
-            label: CellLabel::Bin(k),
-        })
+        .map(|k| Cell { observed: observed[k] as f64, expected: expected[k], label: CellLabel::Bin(k) })
         .collect();
     cells.push(Cell {
         observed: n_failed as f64,
@@ -159,13 +146,7 @@ pub fn chi2_sphere(
                 let (i, j) = (k / res_phi, k % res_phi);
                 let z0 = -1.0 + i as f64 * dz;
                 let p0 = j as f64 * dphi;
-                format!(
-                    "bin cosθ∈[{:.3},{:.3}] φ∈[{:.3},{:.3}]",
-                    z0,
-                    z0 + dz,
-                    p0,
-                    p0 + dphi
-                )
+                format!("bin cosθ∈[{:.3},{:.3}] φ∈[{:.3},{:.3}]", z0, z0 + dz, p0, p0 + dphi)
             }
             CellLabel::Missing => "missing mass (failed samples)".to_string(),
         }
@@ -178,11 +159,7 @@ pub fn chi2_sphere(
     );
     if n_invalid > 0 {
         result.passed = false;
-        let _ = writeln!(
-            head,
-            "FAIL: {} samples were not unit vectors (first: {:?})",
-            n_invalid, first_invalid
-        );
+        let _ = writeln!(head, "FAIL: {} samples were not unit vectors (first: {:?})", n_invalid, first_invalid);
     }
     if non_finite_pdf {
         result.passed = false;
@@ -196,12 +173,7 @@ pub fn chi2_sphere(
 /// outcomes this is the binomial test of e.g. reflection vs transmission frequency). `probs` may sum to
 /// less than 1; the remainder is an extra "other" outcome expected `n·(1 − Σ probs)` times, where
 /// `n = Σ counts + other_count`.
-pub fn chi2_discrete(
-    counts: &[u64],
-    other_count: u64,
-    probs: &[f64],
-    significance: f64,
-) -> Chi2Result {
+pub fn chi2_discrete(counts: &[u64], other_count: u64, probs: &[f64], significance: f64) -> Chi2Result {
     let n = (counts.iter().sum::<u64>() + other_count) as f64;
     let total_p: f64 = probs.iter().sum();
     let mut cells: Vec<Cell> = counts
@@ -226,18 +198,11 @@ pub fn chi2_discrete(
     };
     let mut r = pearson(cells, significance, &describe);
     r.pdf_integral = total_p;
-    let mut head = format!(
-        "chi2_discrete: {} samples, counts {:?} (+{} other), probs {:?}\n",
-        n, counts, other_count, probs
-    );
+    let mut head =
+        format!("chi2_discrete: {} samples, counts {:?} (+{} other), probs {:?}\n", n, counts, other_count, probs);
     if probs.len() != counts.len() {
         r.passed = false;
-        let _ = writeln!(
-            head,
-            "FAIL: {} counts but {} probabilities",
-            counts.len(),
-            probs.len()
-        );
+        let _ = writeln!(head, "FAIL: {} counts but {} probabilities", counts.len(), probs.len());
     }
     r.report = head + &r.report;
     r
@@ -259,11 +224,7 @@ struct Cell {
 /// Pearson's statistic with Mitsuba's pooling: cells sorted by expected count, those below 5 pooled
 /// into one cell (together with the next cells until the pool reaches 5); observations in a cell
 /// with expected count 0 fail the test outright.
-fn pearson(
-    mut cells: Vec<Cell>,
-    significance: f64,
-    describe: &dyn Fn(CellLabel) -> String,
-) -> Chi2Result {
+fn pearson(mut cells: Vec<Cell>, significance: f64, describe: &dyn Fn(CellLabel) -> String) -> Chi2Result {
     let mut report = String::new();
     let mut impossible = 0u64;
     let mut contrib: Vec<(f64, Cell)> = Vec::new();
@@ -303,11 +264,7 @@ fn pearson(
         dof += 1;
     }
     let dof = dof.saturating_sub(1);
-    let p_value = if dof == 0 {
-        1.0
-    } else {
-        gamma_q(dof as f64 / 2.0, chi2 / 2.0)
-    };
+    let p_value = if dof == 0 { 1.0 } else { gamma_q(dof as f64 / 2.0, chi2 / 2.0) };
     let passed = impossible == 0 && p_value > significance;
     let _ = writeln!(
         report,
@@ -334,14 +291,7 @@ fn pearson(
             );
         }
     }
-    Chi2Result {
-        p_value,
-        chi2,
-        dof,
-        passed,
-        pdf_integral: 0.0,
-        report,
-    }
+    Chi2Result { p_value, chi2, dof, passed, pdf_integral: 0.0, report }
 }
 
 /// The (cos θ, φ) bin of a unit direction.
