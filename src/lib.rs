@@ -4,6 +4,9 @@
 //! Data flow: `scene.xml` → [`scene::xml`] (tree with positions) → [`scene::desc`] (typed properties)
 //! → scene build (meshes, BVH, plugins) → render (tiles, film) → EXR.
 
+// `!(x > 0.0)` is how this crate rejects NaN together with non-positive values: deliberate.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod bsdf;
 pub mod color;
 pub mod compare;

@@ -17,6 +17,7 @@ use crate::texture::Texture;
 
 /// An emitter of the scene: an area light bound to a shape, or a standalone emitter.
 #[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)] // one per emitter, never per hit: no need to box
 pub enum SceneEmitter {
     /// Mitsuba's `area` emitter: emits `radiance` from the front side of shape `shape`.
     Area {
