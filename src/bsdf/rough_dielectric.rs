@@ -289,9 +289,35 @@ impl RoughDielectric {
         (value, pdf * dwh_dwo.abs())
     }
 
-    /// Sampling density of `wo` alone.
+    /// Sampling density of `wo` alone (Mitsuba's `pdf`: no D·G evaluation of the value).
     pub fn pdf(&self, ctx: &BsdfContext, si: &SurfaceInteraction, wo: Vec3) -> f32 {
-        self.eval_pdf(ctx, si, wo).1
+        let wi = si.wi;
+        let (cos_theta_i, cos_theta_o) = (wi.z, wo.z);
+        let has_reflection = ctx.is_enabled(flags::GLOSSY_REFLECTION, 0);
+        let has_transmission = ctx.is_enabled(flags::GLOSSY_TRANSMISSION, 1);
+        let is_reflection = cos_theta_i * cos_theta_o > 0.0;
+        if cos_theta_i == 0.0 || !((has_reflection && is_reflection) || (has_transmission && !is_reflection)) {
+            return 0.0;
+        }
+        let eta = if cos_theta_i > 0.0 { self.eta } else { self.inv_eta };
+        let m = (wi + wo * if is_reflection { 1.0 } else { eta }).normalize();
+        let m = mulsign(m, m.z);
+        let (dot_wi_m, dot_wo_m) = (wi.dot(m), wo.dot(m));
+        if !(dot_wi_m * cos_theta_i > 0.0 && dot_wo_m * cos_theta_o > 0.0) {
+            return 0.0;
+        }
+        let mut pdf = self.sample_distr(cos_theta_i).pdf(mulsign(wi, cos_theta_i), m);
+        if has_reflection && has_transmission {
+            let f = fresnel(dot_wi_m, self.eta).0;
+            pdf *= if is_reflection { f } else { 1.0 - f };
+        }
+        let dwh_dwo = if is_reflection {
+            1.0 / (4.0 * dot_wo_m)
+        } else {
+            let denom = dot_wi_m + eta * dot_wo_m;
+            eta * eta * dot_wo_m / (denom * denom)
+        };
+        pdf * dwh_dwo.abs()
     }
 }
 
