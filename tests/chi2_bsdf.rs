@@ -434,6 +434,48 @@ fn null_passes_straight_through() {
     assert_eq!(load("diffuse", vec![]).eval_null_transmission(&si), Spectrum::ZERO);
 }
 
+/// `specular_reflectance` / `specular_transmittance` multiply their lobe only.
+#[test]
+fn specular_factors_scale_their_lobe() {
+    let half = |name: &'static str| (name, Value::Float(0.5));
+    let si = si_with_wi(sph(30.0, 20.0));
+    let ctx = BsdfContext::default();
+    // Smooth: the sampled weights.
+    let plain = load("dielectric", vec![]);
+    let tinted_t = load("dielectric", vec![half("specular_transmittance")]);
+    let tinted_r = load("dielectric", vec![half("specular_reflectance")]);
+    for s1 in [0.01f32, 0.9] {
+        let (bs, w) = plain.sample(&ctx, &si, s1, Vec2::ZERO).unwrap();
+        let (_, wt) = tinted_t.sample(&ctx, &si, s1, Vec2::ZERO).unwrap();
+        let (_, wr) = tinted_r.sample(&ctx, &si, s1, Vec2::ZERO).unwrap();
+        let (ft, fr) = if bs.sampled_component == 1 { (0.5, 1.0) } else { (1.0, 0.5) };
+        assert!((wt - w * ft).abs().max_element() < 1e-7 && (wr - w * fr).abs().max_element() < 1e-7);
+    }
+    // Rough: eval of each side.
+    let plain = rough(true, 0.3, 0.3, 1.5, 1.0, true);
+    let tinted = load(
+        "roughdielectric",
+        vec![
+            ("distribution", Value::String("ggx".into())),
+            ("alpha", Value::Float(0.3)),
+            ("int_ior", Value::Float(1.5)),
+            ("ext_ior", Value::Float(1.0)),
+            half("specular_transmittance"),
+        ],
+    );
+    let (wo_r, wo_t) = (sph(35.0, 200.0), sph(160.0, 200.0));
+    assert_eq!(tinted.eval(&ctx, &si, wo_r), plain.eval(&ctx, &si, wo_r));
+    assert!(plain.eval(&ctx, &si, wo_t).x > 0.0);
+    assert!((tinted.eval(&ctx, &si, wo_t) - 0.5 * plain.eval(&ctx, &si, wo_t)).abs().max_element() < 1e-7);
+    assert_eq!(tinted.pdf(&ctx, &si, wo_t), plain.pdf(&ctx, &si, wo_t));
+    // Thin: null transmission.
+    let thin = load("thindielectric", vec![half("specular_transmittance")]);
+    let plain_thin = load("thindielectric", vec![]);
+    assert!(
+        (thin.eval_null_transmission(&si) - 0.5 * plain_thin.eval_null_transmission(&si)).abs().max_element() < 1e-7
+    );
+}
+
 // ---- Parsing ----
 
 #[test]

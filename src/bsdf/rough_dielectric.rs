@@ -23,6 +23,14 @@
 //! Sampling picks a normal m (visible normals, or D(m) cos θm with Walter's roughness scaling
 //! 1.2 − 0.2 √|cos θi| when `sample_visible` is false), then reflection with probability F.
 //!
+//! Two Mitsuba 3.9 behaviours are reproduced on purpose, so that renders agree:
+//! - with `sample_visible = false` the sample weight is G·|wi·m| / (|cos θi| cos θm), which omits
+//!   the factor D(m)/D'(m) between the true and the widened distribution: the weight is then
+//!   eval/pdf · D'(m)/D(m), not eval/pdf (Mitsuba 0.5 had the factor);
+//! - the Beckmann masking term is Mitsuba's rational fit (< 0.35% error) while visible normals are
+//!   drawn by inverting the exact distribution, so the Beckmann visible-normal pdf integrates to
+//!   G1_fit(wi)/G1_exact(wi) ≈ 1 instead of exactly 1.
+//!
 //! ```xml
 //! <bsdf type="roughdielectric">
 //!     <string name="distribution" value="ggx"/>
