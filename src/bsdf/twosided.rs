@@ -116,3 +116,41 @@ pub(super) fn eval_pdf(
     let nested = if back_side { back } else { front };
     nested.eval_pdf(ctx, &si_front, flip_z(wo, back_side))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::si_with_wi;
+    use super::super::Diffuse;
+    use super::*;
+    use crate::texture::Texture;
+
+    fn diffuse(c: Spectrum) -> Bsdf {
+        Bsdf::Diffuse(Diffuse { reflectance: Texture::Const(c) })
+    }
+
+    #[test]
+    fn front_and_back_models() {
+        let (red, blue) = (Spectrum::new(0.8, 0.1, 0.1), Spectrum::new(0.1, 0.1, 0.8));
+        let b = Bsdf::TwoSided(Box::new(diffuse(red)), Box::new(diffuse(blue)));
+        let ctx = BsdfContext::default();
+        // Front: the first model, sampled into the upper hemisphere.
+        let si = si_with_wi(Vec3::new(0.3, 0.1, 0.9).normalize());
+        let (bs, w) = b.sample(&ctx, &si, 0.5, Vec2::new(0.2, 0.7)).unwrap();
+        assert!(bs.wo.z > 0.0 && w == red);
+        // Back: the second model, mirrored into the lower hemisphere, same pdf as the mirrored front.
+        let si_back = si_with_wi(Vec3::new(0.3, 0.1, -0.9).normalize());
+        let (bs_back, w) = b.sample(&ctx, &si_back, 0.5, Vec2::new(0.2, 0.7)).unwrap();
+        assert!(w == blue && bs_back.wo == Vec3::new(bs.wo.x, bs.wo.y, -bs.wo.z));
+        let (e, p) = b.eval_pdf(&ctx, &si_back, bs_back.wo);
+        assert!((e - blue * bs.wo.z / crate::math::PI).abs().max_element() < 1e-6);
+        assert!((p - bs.pdf).abs() < 1e-6);
+        // Light leaving through the other side is not scattered.
+        assert_eq!(b.eval(&ctx, &si_back, bs.wo), Spectrum::ZERO);
+        assert_eq!(b.pdf(&ctx, &si, bs_back.wo), 0.0);
+        // Components: front diffuse (front side), back diffuse (back side).
+        assert_eq!(b.component_count(), 2);
+        assert_eq!(b.component_flags(0), flags::DIFFUSE_REFLECTION | flags::FRONT_SIDE);
+        assert_eq!(b.component_flags(1), flags::DIFFUSE_REFLECTION | flags::BACK_SIDE);
+        assert_eq!(b.flags(), flags::DIFFUSE_REFLECTION | flags::FRONT_SIDE | flags::BACK_SIDE);
+    }
+}
