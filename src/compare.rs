@@ -168,7 +168,7 @@ mod tests {
         let n = 1000;
         let a = vec![[1.0f32; 3]; n];
         let b = vec![[1.05f32; 3]; n];
-        let v = vec![[1e-4f32; 3]; n];
+        let v = vec![[1e-6f32; 3]; n];
         assert!(!z_test(&a, &v, &b, &v, 0.01).passed);
         assert!(z_test(&a, &v, &a, &v, 0.01).passed);
     }

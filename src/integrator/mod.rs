@@ -55,13 +55,15 @@ impl IntegratorDesc {
             "volpath" => IntegratorKind::Volpath,
             "volpathmis" => IntegratorKind::Volpathmis,
             "volpath_snee" => IntegratorKind::VolpathSnee,
-            other => return Err(Error::at(
-                &obj.pos,
-                format!(
+            other => {
+                return Err(Error::at(
+                    &obj.pos,
+                    format!(
                     "integrator \"{}\" is not supported (supported: path, volpath, volpathmis, volpath_snee, moment)",
                     other
                 ),
-            )),
+                ))
+            }
         };
         let max_depth = props.int("max_depth", -1)?;
         if max_depth < -1 {
