@@ -62,6 +62,13 @@ impl Accel {
                         let mut b = BvhAabb { min: v[0], max: v[0] };
                         b.min = b.min.min(v[1]).min(v[2]);
                         b.max = b.max.max(v[1]).max(v[2]);
+                        // Pad the box: obvhs's ray/box test is not conservative for a ray through a
+                        // box corner (a vertex shared by triangles), which let rays slip through
+                        // closed meshes. The padding only costs a few extra triangle tests.
+                        let pad =
+                            (b.max - b.min).max_element() * 1e-4 + b.min.abs().max(b.max.abs()).max_element() * 1e-6;
+                        b.min -= Vec3A::splat(pad);
+                        b.max += Vec3A::splat(pad);
                         prims.push(PrimRef { shape: si as u32, prim: pi as u32, analytic: false });
                         bounds.push(BoundsPrim(b));
                         tris.push(v);
