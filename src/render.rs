@@ -6,7 +6,7 @@
 
 use crate::color::Spectrum;
 use crate::integrator::stats::{LocalStats, Stats};
-use crate::integrator::{path, volpath, IntegratorKind};
+use crate::integrator::{path, snee, volpath, volpathmis, IntegratorKind};
 use crate::math::Vec2;
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
@@ -69,7 +69,9 @@ impl RenderStats {
 fn sample_li(scene: &Scene, sampler: &mut Sampler, ray: crate::math::Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
     match scene.integrator.kind {
         IntegratorKind::Path => path::li(scene, sampler, ray, stats),
-        _ => volpath::li(scene, sampler, ray, scene.sensor_medium, stats),
+        IntegratorKind::Volpath => volpath::li(scene, sampler, ray, scene.sensor_medium, stats),
+        IntegratorKind::Volpathmis => volpathmis::li(scene, sampler, ray, scene.sensor_medium, stats),
+        IntegratorKind::VolpathSnee => snee::li(scene, sampler, ray, scene.sensor_medium, stats),
     }
 }
 

@@ -2,8 +2,10 @@
 //! `moment` wrapper that also outputs the per-pixel second moment.
 
 pub mod path;
+pub mod snee;
 pub mod stats;
 pub mod volpath;
+pub mod volpathmis;
 
 use crate::scene::desc::{ObjectDesc, PluginKind};
 use crate::scene::{Error, Result};
