@@ -102,6 +102,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
         }
     }
     let nch = channels.len();
+    let ray_weight = scene.camera.ray_weight();
     let total_spp = match (opts.spp, opts.time_budget) {
         (Some(s), _) => s,
         (None, Some(_)) => u32::MAX,
@@ -163,6 +164,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
                         let aperture = sampler.next_2d();
                         let ray = scene.camera.sample_ray(pos, aperture);
                         let (mut l, valid) = sample_li(scene, &mut sampler, ray, &mut local);
+                        l *= ray_weight;
                         if !l.is_finite() {
                             local.rejected_samples += 1;
                             l = Spectrum::ZERO;

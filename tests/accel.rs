@@ -142,3 +142,17 @@ fn closest_hit_and_occlusion_agree() {
     }
     let _ = Vec2::ZERO;
 }
+
+#[test]
+fn negative_zero_directions_hit() {
+    // Axis-aligned rays often carry −0.0 components (e.g. after negating a vector).
+    let shapes = vec![shape(icosphere(2), Mat4::IDENTITY)];
+    let accel = Accel::build(&shapes);
+    for d in
+        [Vec3::new(-0.0, -0.0, 1.0), Vec3::new(0.0, -0.0, -1.0), Vec3::new(-1.0, -0.0, 0.0), Vec3::new(0.0, 1.0, -0.0)]
+    {
+        let inside = Ray::new(Vec3::new(0.1, 0.05, -0.02), d);
+        assert!(accel.intersect(&shapes, &inside).is_some(), "ray along {:?} leaked", d);
+        assert!(accel.occluded(&shapes, &inside), "shadow ray along {:?} leaked", d);
+    }
+}
