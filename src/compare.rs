@@ -102,6 +102,43 @@ pub struct ZTest {
     pub worst: (usize, usize, f64),
 }
 
+impl ZTest {
+    pub fn to_json(&self) -> serde_json::Value {
+        json!({"tests": self.tests, "min_p": self.min_p, "sidak_level": self.level, "passed": self.passed,
+               "worst_pixel": self.worst.0, "worst_channel": self.worst.1, "worst_z": self.worst.2})
+    }
+    pub fn to_text(&self) -> String {
+        format!(
+            "Z-test  {} ({} tests, min p {:.3e}, Šidák level {:.3e} for α = 0.01; worst pixel {} channel {} z {:.2})\n",
+            if self.passed { "passed" } else { "FAILED" },
+            self.tests,
+            self.min_p,
+            self.level,
+            self.worst.0,
+            self.worst.1,
+            self.worst.2
+        )
+    }
+}
+
+/// Variance of each pixel's mean: per-sample variance (ignoring the reconstruction filter's variance
+/// factor, which `tests/references.rs` applies; for a Gaussian filter this overestimates the
+/// variance inside the image and underestimates it in the corners) (`var.*`, or `m2.*` minus the squared mean)
+/// divided by the sample count. `None` when the image has neither or `spp` is unknown.
+pub fn variance_of_mean(b: &Bitmap, spp: Option<f64>) -> Option<Vec<[f32; 3]>> {
+    let spp = spp.filter(|s| *s > 0.0)? as f32;
+    let mean = rgb_of(b).ok()?;
+    let n = b.channels.len();
+    let ch = |p: &str| -> Option<[usize; 3]> {
+        Some([b.channel(&format!("{p}.R"))?, b.channel(&format!("{p}.G"))?, b.channel(&format!("{p}.B"))?])
+    };
+    if let Some(v) = ch("var") {
+        return Some(b.data.chunks(n).map(|p| [0, 1, 2].map(|c| p[v[c]].max(0.0) / spp)).collect());
+    }
+    let m2 = ch("m2")?;
+    Some(b.data.chunks(n).zip(&mean).map(|(p, m)| [0, 1, 2].map(|c| (p[m2[c]] - m[c] * m[c]).max(0.0) / spp)).collect())
+}
+
 /// Two-sample Z-test of means `a`, `b` with variances of the means `va`, `vb` (per pixel and channel),
 /// at family-wise level `alpha` with Šidák's correction over all tests.
 pub fn z_test(a: &[[f32; 3]], va: &[[f32; 3]], b: &[[f32; 3]], vb: &[[f32; 3]], alpha: f64) -> ZTest {

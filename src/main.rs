@@ -64,6 +64,9 @@ enum Command {
         /// No progress bar.
         #[arg(long, short)]
         quiet: bool,
+        /// Also write the per-pixel second moment (channels m2.R, m2.G, m2.B), as Mitsuba's `moment`.
+        #[arg(long)]
+        moment: bool,
     },
     /// Compare two EXR images: MSE, relMSE, mean ratio, and a per-pixel Z-test when variances are present.
     Compare {
@@ -71,6 +74,12 @@ enum Command {
         b: PathBuf,
         #[arg(long)]
         json: bool,
+        /// Samples per pixel of A (default: "spp" from A.json beside A.exr), for the Z-test.
+        #[arg(long)]
+        spp_a: Option<f64>,
+        /// Samples per pixel of B (default: "spp" from B.json beside B.exr).
+        #[arg(long)]
+        spp_b: Option<f64>,
     },
 }
 
@@ -115,14 +124,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Render { scene, output, define, spp, seed, threads, time, stats, png, quiet } => {
+        Command::Render { scene, output, define, spp, seed, threads, time, stats, png, quiet, moment } => {
             // Before loading: building the BVH already starts rayon's global pool.
             if let Some(t) = threads {
                 rayon::ThreadPoolBuilder::new().num_threads(t.max(1)).build_global().context("setting up threads")?;
             }
             let scene_path = scene.unwrap_or_else(|| PathBuf::from(DEFAULT_SCENE));
             let defines = parse_defines(&define)?;
-            let loaded = load_scene(&scene_path, &defines)?;
+            let mut loaded = load_scene(&scene_path, &defines)?;
+            loaded.integrator.moment |= moment;
             snee::render::check_renderable(&loaded).map_err(|e| anyhow!("{}: {}", scene_path.display(), e))?;
             if let Some(t) = time {
                 if !(t > 0.0 && t.is_finite()) {
@@ -161,14 +171,42 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Compare { a, b, json } => {
+        Command::Compare { a, b, json, spp_a, spp_b } => {
             let ia = snee::io::read::read_image(&a, false)?;
             let ib = snee::io::read::read_image(&b, false)?;
             let r = snee::compare::compare(&ia, &ib).map_err(|e| anyhow!(e))?;
+            let spp = |given: Option<f64>, path: &Path| {
+                given.or_else(|| {
+                    let text = std::fs::read_to_string(path.with_extension("json")).ok()?;
+                    serde_json::from_str::<serde_json::Value>(&text).ok()?["spp"].as_f64()
+                })
+            };
+            // Per-pixel Z-test when both images carry a per-sample variance and a sample count.
+            let z = match (
+                snee::compare::variance_of_mean(&ia, spp(spp_a, &a)),
+                snee::compare::variance_of_mean(&ib, spp(spp_b, &b)),
+            ) {
+                (Some(va), Some(vb)) => {
+                    let (ma, mb) = (
+                        snee::compare::rgb_of(&ia).map_err(|e| anyhow!(e))?,
+                        snee::compare::rgb_of(&ib).map_err(|e| anyhow!(e))?,
+                    );
+                    Some(snee::compare::z_test(&ma, &va, &mb, &vb, 0.01))
+                }
+                _ => None,
+            };
             if json {
-                println!("{}", serde_json::to_string_pretty(&r.to_json())?);
+                let mut v = r.to_json();
+                if let Some(z) = &z {
+                    v["z_test"] = z.to_json();
+                }
+                println!("{}", serde_json::to_string_pretty(&v)?);
             } else {
                 print!("{}", r.to_text());
+                match &z {
+                    Some(z) => print!("{}", z.to_text()),
+                    None => println!("Z-test: skipped (needs var.* or m2.* channels and the spp of both images)"),
+                }
             }
             Ok(())
         }

@@ -127,3 +127,23 @@ fn same_seed_same_image_whatever_the_thread_count() {
     let differing = images[0].iter().zip(&images[1]).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
     assert_eq!(differing, 0, "{} values differ between 1 and 2 threads", differing);
 }
+
+#[test]
+fn compare_reports_metrics_and_z_test() {
+    let dir = out_dir();
+    let exr = dir.join("cmp.exr");
+    let o = snee()
+        .args(["render", "scenes/cornell_box.xml", "-o", exr.to_str().unwrap(), "--spp", "16", "--moment", "-q"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = snee()
+        .args(["compare", exr.to_str().unwrap(), "reference/cornell_box.exr", "--spp-a", "16", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!((v["mean_ratio"].as_f64().unwrap() - 1.0).abs() < 0.05);
+    assert!(v["rel_mse"].as_f64().unwrap() > 0.0);
+    assert!(v["z_test"]["tests"].as_u64().unwrap() == 96 * 96 * 3);
+}
