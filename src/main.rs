@@ -116,13 +116,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Render { scene, output, define, spp, seed, threads, time, stats, png, quiet } => {
+            // Before loading: building the BVH already starts rayon's global pool.
+            if let Some(t) = threads {
+                rayon::ThreadPoolBuilder::new().num_threads(t.max(1)).build_global().context("setting up threads")?;
+            }
             let scene_path = scene.unwrap_or_else(|| PathBuf::from(DEFAULT_SCENE));
             let defines = parse_defines(&define)?;
             let loaded = load_scene(&scene_path, &defines)?;
             snee::render::check_renderable(&loaded).map_err(|e| anyhow!("{}: {}", scene_path.display(), e))?;
-            if let Some(t) = threads {
-                rayon::ThreadPoolBuilder::new().num_threads(t.max(1)).build_global().context("setting up threads")?;
-            }
             if let Some(t) = time {
                 if !(t > 0.0 && t.is_finite()) {
                     return Err(anyhow!("--time expects a positive number of seconds"));

@@ -14,7 +14,6 @@ use crate::sensor::film::PixelFormat;
 use crate::sensor::image_block::ImageBlock;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Mutex;
 use std::time::Instant;
 
 const TILE: u32 = 16;
@@ -102,6 +101,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
         }
     }
     let nch = channels.len();
+    let ray_weight = scene.camera.ray_weight();
     let total_spp = match (opts.spp, opts.time_budget) {
         (Some(s), _) => s,
         (None, Some(_)) => u32::MAX,
@@ -114,7 +114,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
             tiles.push((sx + tx as i32, sy + ty as i32, TILE.min(sw - tx), TILE.min(sh - ty)));
         }
     }
-    let full = Mutex::new(film.create_block(nch));
+    let mut full = film.create_block(nch);
     let stats = Stats::default();
     let start = Instant::now();
     let pixels = sw as u64 * sh as u64;
@@ -143,51 +143,58 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
         let pass_spp = (1u32 << pass.min(6)).min(total_spp - spp_done);
         let first_sample = spp_done;
         let completed = std::sync::atomic::AtomicU64::new(0);
-        tiles.par_iter().for_each(|&(x0, y0, w, h)| {
-            if cancel.load(Ordering::Relaxed) {
-                return;
-            }
-            let mut block = ImageBlock::new((x0, y0), (w, h), film.filter, nch);
-            let mut local = LocalStats::default();
-            let mut values = vec![0.0f32; nch];
-            for y in y0..y0 + h as i32 {
-                for x in x0..x0 + w as i32 {
-                    // Unique per film pixel (the border may lie outside the film: offset it).
-                    let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
-                    let mut sampler = Sampler::new(
-                        opts.seed,
-                        pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(first_sample as u64),
-                    );
-                    for _ in 0..pass_spp {
-                        let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-                        let aperture = sampler.next_2d();
-                        let ray = scene.camera.sample_ray(pos, aperture);
-                        let (mut l, valid) = sample_li(scene, &mut sampler, ray, &mut local);
-                        if !l.is_finite() {
-                            local.rejected_samples += 1;
-                            l = Spectrum::ZERO;
+        // Tiles render in parallel; their blocks merge in tile order so the floating-point sums (and
+        // so the image) do not depend on the thread count.
+        let blocks: Vec<Option<ImageBlock>> = tiles
+            .par_iter()
+            .map(|&(x0, y0, w, h)| {
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let mut block = ImageBlock::new((x0, y0), (w, h), film.filter, nch);
+                let mut local = LocalStats::default();
+                let mut values = vec![0.0f32; nch];
+                for y in y0..y0 + h as i32 {
+                    for x in x0..x0 + w as i32 {
+                        // Unique per film pixel (the border may lie outside the film: offset it).
+                        let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
+                        let mut sampler = Sampler::new(
+                            opts.seed,
+                            pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(first_sample as u64),
+                        );
+                        for _ in 0..pass_spp {
+                            let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                            let aperture = sampler.next_2d();
+                            let ray = scene.camera.sample_ray(pos, aperture);
+                            let (mut l, valid) = sample_li(scene, &mut sampler, ray, &mut local);
+                            l *= ray_weight;
+                            if !l.is_finite() {
+                                local.rejected_samples += 1;
+                                l = Spectrum::ZERO;
+                            }
+                            values[..3].copy_from_slice(&l.to_array());
+                            let mut k = 3;
+                            if rgba {
+                                values[3] = if valid { 1.0 } else { 0.0 };
+                                k = 4;
+                            }
+                            if moment {
+                                values[k..k + 3].copy_from_slice(&(l * l).to_array());
+                            }
+                            block.put(pos, &values);
                         }
-                        values[..3].copy_from_slice(&l.to_array());
-                        let mut k = 3;
-                        if rgba {
-                            values[3] = if valid { 1.0 } else { 0.0 };
-                            k = 4;
-                        }
-                        if moment {
-                            values[k..k + 3].copy_from_slice(&(l * l).to_array());
-                        }
-                        block.put(pos, &values);
                     }
                 }
-            }
-            stats.add(&local);
-            if let Ok(mut f) = full.lock() {
-                f.merge(&block);
-            }
-            let n = w as u64 * h as u64 * pass_spp as u64;
-            completed.fetch_add(n, Ordering::Relaxed);
-            bar.inc(n);
-        });
+                stats.add(&local);
+                let n = w as u64 * h as u64 * pass_spp as u64;
+                completed.fetch_add(n, Ordering::Relaxed);
+                bar.inc(n);
+                Some(block)
+            })
+            .collect();
+        for block in blocks.iter().flatten() {
+            full.merge(block);
+        }
         samples_done += completed.load(Ordering::Relaxed);
         if cancel.load(Ordering::Relaxed) {
             break;
@@ -200,7 +207,7 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
     }
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
-    let data = full.into_inner().map(|f| f.develop()).unwrap_or_default();
+    let data = full.develop();
     RenderOutput {
         width: cw as usize,
         height: ch as usize,

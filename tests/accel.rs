@@ -84,8 +84,9 @@ fn shape(data: MeshData, to_world: Mat4) -> Shape {
 
 #[test]
 fn closed_mesh_does_not_leak() {
-    // 20·4^7 = 327,680 triangles (the 1M-triangle measurement is in the README / bench).
-    let data = icosphere(7);
+    // 20·4^7 = 327,680 triangles by default; `SNEE_LEAK_LEVEL=8` gives 1,310,720 (the README's number).
+    let level = std::env::var("SNEE_LEAK_LEVEL").ok().and_then(|v| v.parse().ok()).unwrap_or(7);
+    let data = icosphere(level);
     let verts = data.positions.clone();
     let to_world = Mat4::from_translation(Vec3::new(0.3, -0.2, 5.0)) * Mat4::from_scale(Vec3::splat(2.0));
     let shapes = vec![shape(data, to_world)];
@@ -120,6 +121,7 @@ fn closed_mesh_does_not_leak() {
             leaks += 1;
         }
     }
+    eprintln!("{} triangles: {} of {} rays leaked", 20 * 4u64.pow(level), leaks, rays);
     assert_eq!(leaks, 0, "{} of {} rays leaked through the closed mesh", leaks, rays);
 }
 
@@ -141,4 +143,18 @@ fn closest_hit_and_occlusion_agree() {
         }
     }
     let _ = Vec2::ZERO;
+}
+
+#[test]
+fn negative_zero_directions_hit() {
+    // Axis-aligned rays often carry −0.0 components (e.g. after negating a vector).
+    let shapes = vec![shape(icosphere(2), Mat4::IDENTITY)];
+    let accel = Accel::build(&shapes);
+    for d in
+        [Vec3::new(-0.0, -0.0, 1.0), Vec3::new(0.0, -0.0, -1.0), Vec3::new(-1.0, -0.0, 0.0), Vec3::new(0.0, 1.0, -0.0)]
+    {
+        let inside = Ray::new(Vec3::new(0.1, 0.05, -0.02), d);
+        assert!(accel.intersect(&shapes, &inside).is_some(), "ray along {:?} leaked", d);
+        assert!(accel.occluded(&shapes, &inside), "shadow ray along {:?} leaked", d);
+    }
 }

@@ -262,7 +262,7 @@ fn perspective_rays_match_mitsuba() {
 fn camera_orientation_conventions() {
     // Local +Z forward, +Y up, +X is the image's left; image y grows downward.
     let s = sensor(obj(PluginKind::Sensor, "perspective").with("fov", Value::Float(90.0))).unwrap();
-    let Camera::Perspective(p) = &s.camera;
+    let Camera::Perspective(p) = &s.camera else { panic!("expected a perspective camera") };
     assert_eq!(p.x_fov, 90.0);
     let (w, h) = (s.film.width as f32, s.film.height as f32);
     let left = s.camera.sample_ray(Vec2::new(0.0, h / 2.0), Vec2::ZERO).d;
@@ -284,7 +284,7 @@ fn defaults_match_mitsuba() {
     assert_eq!(s.sampler.kind, SamplerKind::Independent);
     assert_eq!((s.sampler.sample_count, s.sampler.seed), (4, 0));
     assert!(s.medium_ref.is_none());
-    let Camera::Perspective(p) = &s.camera;
+    let Camera::Perspective(p) = &s.camera else { panic!("expected a perspective camera") };
     // 50 mm on the diagonal of a 4:3 film: Mitsuba 3.9.1 reports x_fov = 38.18484115600586 for 768x576
     // (`mi.traverse(mi.load_dict({'type': 'perspective'}))['x_fov']`).
     assert!((p.x_fov - 38.184_84).abs() < 1e-4, "x_fov {}", p.x_fov);

@@ -40,6 +40,8 @@ struct Builder<'a> {
     environment: Option<(u32, ObjectPos)>,
     default_bsdf: Option<u32>,
     black_bsdf: Option<u32>,
+    /// An irradiance meter nested in a shape, with its position.
+    meter: Option<(Sensor, ObjectPos)>,
 }
 
 type ObjectPos = super::SrcPos;
@@ -57,6 +59,7 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         environment: None,
         default_bsdf: None,
         black_bsdf: None,
+        meter: None,
     };
     let mut integrator: Option<(IntegratorDesc, ObjectPos)> = None;
     let mut sensor: Option<Sensor> = None;
@@ -111,8 +114,24 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         }
     }
     root.props.finish()?;
-    let Some(mut sensor) = sensor else {
-        return Err(Error::at(&root.pos, "the scene has no <sensor> (a perspective camera is needed to render)"));
+    let mut sensor = match (sensor, b.meter.take()) {
+        (Some(s), None) => s,
+        (None, Some((m, _))) => m,
+        (Some(_), Some((_, pos))) => {
+            return Err(Error::at(
+                &pos,
+                format!(
+                    "only one sensor is supported (a perspective sensor is at {})",
+                    sensor_pos.map(|p| p.to_string()).unwrap_or_default()
+                ),
+            ));
+        }
+        (None, None) => {
+            return Err(Error::at(
+                &root.pos,
+                "the scene has no <sensor> (a perspective camera or an irradiancemeter is needed to render)",
+            ));
+        }
     };
     let sensor_medium = match sensor.medium_ref.take() {
         Some(m) => Some(b.medium(&m)?),
@@ -308,19 +327,17 @@ impl Builder<'_> {
             self.emitters.push(SceneEmitter::Area { shape: index, radiance });
             emitter = Some((self.emitters.len() - 1) as u32);
         }
-        if let Some(s) = props.object_of(PluginKind::Sensor)? {
-            return Err(Error::at(&s.pos, format!("sensor \"{}\" inside a shape is not supported yet", s.plugin)));
-        }
+        let sensor_desc = props.object_of(PluginKind::Sensor)?;
         props.finish()?;
-        self.shapes.push(Shape {
-            geometry,
-            plugin: obj.plugin.clone(),
-            id: obj.id.clone(),
-            bsdf,
-            emitter,
-            interior,
-            exterior,
-        });
+        let shape =
+            Shape { geometry, plugin: obj.plugin.clone(), id: obj.id.clone(), bsdf, emitter, interior, exterior };
+        if let Some(s) = sensor_desc {
+            if let Some((_, first)) = &self.meter {
+                return Err(Error::at(&s.pos, format!("only one sensor is supported (the first is at {})", first)));
+            }
+            self.meter = Some((Sensor::irradiance_meter(&s, shape.clone())?, s.pos.clone()));
+        }
+        self.shapes.push(shape);
         Ok(())
     }
 }

@@ -30,6 +30,7 @@
 
 pub mod film;
 pub mod image_block;
+pub mod irradiance_meter;
 pub mod perspective;
 pub mod rfilter;
 pub mod sampler_desc;
@@ -57,9 +58,10 @@ pub struct Sensor {
 }
 
 /// The camera models (closed set).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum Camera {
     Perspective(Perspective),
+    IrradianceMeter(irradiance_meter::IrradianceMeter),
 }
 
 impl Sensor {
@@ -70,9 +72,39 @@ impl Sensor {
         if obj.plugin != "perspective" {
             return Err(Error::at(
                 &obj.pos,
-                format!("sensor type \"{}\" is not supported (supported: perspective)", obj.plugin),
+                format!(
+                    "sensor type \"{}\" is not supported here (supported: perspective; irradiancemeter inside a shape)",
+                    obj.plugin
+                ),
             ));
         }
+        let (film, sampler, medium_ref) = Self::nested(obj)?;
+        let camera = Camera::Perspective(Perspective::from_props(props, &film)?);
+        props.finish()?;
+        Ok(Sensor { camera, film, sampler, medium_ref })
+    }
+
+    /// An `irradiancemeter` nested in `shape` (a world-space copy of the shape it measures).
+    pub fn irradiance_meter(obj: &ObjectDesc, shape: crate::shape::Shape) -> Result<Sensor> {
+        if obj.plugin != "irradiancemeter" {
+            return Err(Error::at(
+                &obj.pos,
+                format!("sensor type \"{}\" cannot be nested in a shape (supported: irradiancemeter)", obj.plugin),
+            ));
+        }
+        let (film, sampler, medium_ref) = Self::nested(obj)?;
+        obj.props.finish()?;
+        Ok(Sensor {
+            camera: Camera::IrradianceMeter(irradiance_meter::IrradianceMeter { shape }),
+            film,
+            sampler,
+            medium_ref,
+        })
+    }
+
+    /// The nested film (default hdrfilm), sampler (default independent) and medium of a sensor.
+    fn nested(obj: &ObjectDesc) -> Result<(Film, SamplerDesc, Option<Rc<ObjectDesc>>)> {
+        let props = &obj.props;
         let film = match props.object_of(PluginKind::Film)? {
             Some(f) => Film::from_desc(&f)?,
             None => Film::default(),
@@ -82,9 +114,7 @@ impl Sensor {
             None => SamplerDesc::default(),
         };
         let medium_ref = props.object_of(PluginKind::Medium)?;
-        let camera = Camera::Perspective(Perspective::from_props(props, &film)?);
-        props.finish()?;
-        Ok(Sensor { camera, film, sampler, medium_ref })
+        Ok((film, sampler, medium_ref))
     }
 }
 
@@ -95,6 +125,16 @@ impl Camera {
     pub fn sample_ray(&self, pos: Vec2, aperture_sample: Vec2) -> Ray {
         match self {
             Camera::Perspective(p) => p.sample_ray(pos, aperture_sample),
+            Camera::IrradianceMeter(m) => m.sample_ray(pos, aperture_sample),
+        }
+    }
+
+    /// Importance weight of every primary ray (1 for cameras, π for the irradiance meter).
+    #[inline]
+    pub fn ray_weight(&self) -> f32 {
+        match self {
+            Camera::Perspective(_) => 1.0,
+            Camera::IrradianceMeter(_) => irradiance_meter::IrradianceMeter::WEIGHT,
         }
     }
 
@@ -103,6 +143,7 @@ impl Camera {
     pub fn position(&self) -> Vec3 {
         match self {
             Camera::Perspective(p) => p.position(),
+            Camera::IrradianceMeter(m) => m.shape.bounds().center(),
         }
     }
 }

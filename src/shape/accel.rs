@@ -7,7 +7,7 @@
 //! double-precision fallback when an edge function is exactly zero.
 
 use super::{Geometry, Shape};
-use crate::math::Ray;
+use crate::math::{Ray, Vec3};
 use glam::Vec3A;
 use obvhs::aabb::Aabb as BvhAabb;
 use obvhs::cwbvh::CwBvh;
@@ -94,6 +94,7 @@ impl Accel {
     /// Closest hit along the ray in (0, ray.tmax).
     pub fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
+        let ray = &positive_zeros(ray);
         let wt = WatertightRay::new(ray);
         let bray = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, ray.tmax);
         let mut hit = RayHit::none();
@@ -125,6 +126,7 @@ impl Accel {
     /// True when anything blocks the ray in (0, ray.tmax).
     pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
         let Some(bvh) = self.bvh.as_ref() else { return false };
+        let ray = &positive_zeros(ray);
         let wt = WatertightRay::new(ray);
         let bray = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, ray.tmax);
         !bvh.ray_traverse_miss(bray, |r, id| {
@@ -136,6 +138,13 @@ impl Accel {
             }
         })
     }
+}
+
+/// obvhs's traversal misses everything for a direction with a −0.0 component (its octant from
+/// the sign bit disagrees with its slab test), so turn −0.0 into +0.0 (x + 0.0 does exactly that).
+#[inline]
+fn positive_zeros(ray: &Ray) -> Ray {
+    Ray { o: ray.o, d: ray.d + Vec3::ZERO, tmax: ray.tmax }
 }
 
 #[inline]
