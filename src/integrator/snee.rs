@@ -33,7 +33,7 @@ use super::volpath;
 use crate::bsdf::fresnel::{fresnel, refract};
 use crate::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use crate::color::Spectrum;
-use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
+use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction, SHADOW_EPSILON};
 use crate::math::{warp, Ray, Vec2, Vec3, INV_FOUR_PI};
 use crate::sampler::Sampler;
 use crate::scene::world::{Scene, SceneEmitter};
@@ -174,12 +174,64 @@ fn mixture(scene: &Scene, boundary: Boundary) -> (f32, f32) {
     }
 }
 
-/// True when the segment from `x_k` towards the emitter crosses no surface.
-fn light_visible(scene: &Scene, si_k: &SurfaceInteraction, light: &LightSample, stats: &mut LocalStats) -> bool {
-    let o = offset_origin(si_k.p, si_k.n, light.omega_l);
-    let ray = if light.dist.is_finite() { spawn_ray_between(o, light.p) } else { Ray::new(o, light.omega_l) };
-    stats.rays += 1;
-    !scene.ray_test(&ray)
+/// Upper bound on the interfaces crossed by one light segment.
+const MAX_LIGHT_SEGMENTS: u32 = 64;
+
+/// A surface the light segment `x_k → emitter` may cross: null-transmissive (`null`,
+/// `thindielectric`) and not a medium transition. Deterministic, so that SNEE and forward tracing
+/// agree on SNEE's support (docs/snee.md §1).
+#[inline]
+pub fn passable(scene: &Scene, si: &SurfaceInteraction) -> bool {
+    !volpath::is_medium_transition(scene, si) && scene.bsdf(si).eval_null_transmission(si) != Spectrum::ZERO
+}
+
+/// Walk from `x_k` along `omega_l` up to `tmax` through passable surfaces. Returns the product of
+/// their null transmissions and the first surface that stops the walk (not passable, or an
+/// emitter when `stop_at_emitters`), `None` when the walk reached `tmax` or escaped.
+fn walk_light_segment(
+    scene: &Scene,
+    si_k: &SurfaceInteraction,
+    omega_l: Vec3,
+    tmax: f32,
+    stop_at_emitters: bool,
+    stats: &mut LocalStats,
+) -> (Spectrum, Option<SurfaceInteraction>) {
+    let mut ray = Ray::new(offset_origin(si_k.p, si_k.n, omega_l), omega_l);
+    let mut remaining = tmax;
+    let mut tr = Spectrum::ONE;
+    for _ in 0..MAX_LIGHT_SEGMENTS {
+        ray.tmax = remaining;
+        stats.rays += 1;
+        let Some(hit) = scene.ray_intersect(&ray) else { return (tr, None) };
+        let is_emitter = scene.shapes[hit.shape as usize].emitter.is_some();
+        if (stop_at_emitters && is_emitter) || !passable(scene, &hit) {
+            return (tr, Some(hit));
+        }
+        tr *= scene.bsdf(&hit).eval_null_transmission(&hit);
+        remaining -= hit.t;
+        ray.o = offset_origin(hit.p, hit.n, omega_l);
+    }
+    (Spectrum::ZERO, None)
+}
+
+/// Transmission of the segment from `x_k` towards a sampled emitter point through passable
+/// surfaces; zero when the segment is blocked (then the path is outside SNEE's support).
+fn light_transmission(
+    scene: &Scene,
+    si_k: &SurfaceInteraction,
+    light: &LightSample,
+    stats: &mut LocalStats,
+) -> Spectrum {
+    let tmax = if light.dist.is_finite() {
+        let o = offset_origin(si_k.p, si_k.n, light.omega_l);
+        (light.p - o).length() * (1.0 - SHADOW_EPSILON)
+    } else {
+        f32::INFINITY
+    };
+    match walk_light_segment(scene, si_k, light.omega_l, tmax, false, stats) {
+        (tr, None) => tr,
+        _ => Spectrum::ZERO,
+    }
 }
 
 /// True when the open segment `a → b` crosses no surface.
@@ -188,29 +240,36 @@ fn segment_clear(scene: &Scene, a: Vec3, b: Vec3, stats: &mut LocalStats) -> boo
     !scene.ray_test(&spawn_ray_between(a, b))
 }
 
-/// Emitter sample from `x_k` (↓ step 1), pointing outside and unoccluded.
+/// Emitter sample from `x_k` (↓ step 1), pointing outside and unoccluded; `le` includes the
+/// transmission of passable surfaces on the way.
 fn sample_light(scene: &Scene, si_k: &SurfaceInteraction, u: Vec2, stats: &mut LocalStats) -> Option<LightSample> {
     let (ds, weight) = scene.sample_emitter_direction(si_k.p, None, u, false);
     if !(ds.pdf > 0.0) || weight == Spectrum::ZERO || ds.d.dot(si_k.n) <= 0.0 {
         return None;
     }
-    let light =
+    let mut light =
         LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: ds.delta, le: weight * ds.pdf };
-    light_visible(scene, si_k, &light, stats).then_some(light)
+    let tr = light_transmission(scene, si_k, &light, stats);
+    light.le *= tr;
+    (tr != Spectrum::ZERO).then_some(light)
 }
 
-/// The emitter seen from `x_k` along `omega_l` (area emitter hit first, or the environment).
+/// The emitter seen from `x_k` along `omega_l` through passable surfaces (an area emitter, or
+/// the environment on escape); `le` includes the transmission on the way.
 pub fn light_along(
     scene: &Scene,
     si_k: &SurfaceInteraction,
     omega_l: Vec3,
     stats: &mut LocalStats,
 ) -> Option<LightSample> {
-    stats.rays += 1;
-    match scene.ray_intersect(&Ray::new(offset_origin(si_k.p, si_k.n, omega_l), omega_l)) {
+    let (tr, hit) = walk_light_segment(scene, si_k, omega_l, f32::INFINITY, true, stats);
+    if tr == Spectrum::ZERO {
+        return None;
+    }
+    match hit {
         Some(hit) => {
             scene.shapes[hit.shape as usize].emitter?;
-            let le = scene.eval_area_emitter(&hit);
+            let le = scene.eval_area_emitter(&hit) * tr;
             let ds = scene.direction_sample_for_hit(si_k.p, &hit);
             let p_light = scene.pdf_emitter_direction(si_k.p, &ds);
             (le != Spectrum::ZERO).then_some(LightSample {
@@ -226,7 +285,7 @@ pub fn light_along(
             let env = scene.environment?;
             let ds = scene.environment_direction_sample(env, omega_l);
             let p_light = scene.pdf_emitter_direction(si_k.p, &ds);
-            let le = scene.eval_environment(omega_l);
+            let le = scene.eval_environment(omega_l) * tr;
             (le != Spectrum::ZERO).then_some(LightSample {
                 omega_l,
                 p: si_k.p,
@@ -538,7 +597,9 @@ pub fn forward_weight(
     }
     // SNEE's support: x_k is the probe's first hit from x_i, the light segment is clear.
     let inner_k = offset_origin(s.si_k.p, s.si_k.n, s.x_i.p - s.si_k.p);
-    if !segment_clear(scene, s.x_i.p, inner_k, stats) || !light_visible(scene, &s.si_k, light, stats) {
+    if !segment_clear(scene, s.x_i.p, inner_k, stats)
+        || light_transmission(scene, &s.si_k, light, stats) == Spectrum::ZERO
+    {
         return None;
     }
     let pdfs = suffix_pdfs(scene, s, light, channel);

@@ -446,6 +446,9 @@ pub fn li_with(
         let non_null = bs.sampled_type & flags::NULL == 0;
         if bs.sampled_type & flags::TRANSMISSION != 0 && non_null && wo.dot(s.n) > 0.0 {
             snee_pending = snee_at_k;
+        } else if !non_null && snee::passable(scene, &s) {
+            // A light segment x_k → emitter may cross passable interfaces (docs/snee.md §1).
+            snee_pending = pending;
         }
         if non_null {
             depth += 1;
