@@ -157,8 +157,7 @@ pub fn welch_compare(a: &Batches, b: &Batches, alpha: f64) -> (String, [f64; 3],
                 continue;
             }
             let t = (ma - mb) / se2.sqrt();
-            let dof = se2 * se2
-                / (qa * qa / (va.len() as f64 - 1.0) + qb * qb / (vb.len() as f64 - 1.0)).max(1e-300);
+            let dof = se2 * se2 / (qa * qa / (va.len() as f64 - 1.0) + qb * qb / (vb.len() as f64 - 1.0)).max(1e-300);
             let p = t_p_value(t.abs(), dof.max(1.0));
             if p < level {
                 report += &format!("stat {} ch {}: {:.6} vs {:.6} (t = {:.2}, p = {:.2e})\n", s, c, ma, mb, t, p);
