@@ -1,6 +1,6 @@
 //! Helpers shared by the `snee_*` tests: scenes from XML text, renders in independent batches,
 //! and a Welch t-test on batch means with Šidák's correction.
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use snee::render::{render, RenderOptions};
 use snee::scene::build::build_scene;
