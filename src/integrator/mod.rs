@@ -1,4 +1,4 @@
-//! Integrators: `path` (surfaces only), with `volpath` / `volpath_snee` to come, and the
+//! Integrators: `path` (surfaces only), `volpath`, `volpath_snee` (volpath with subdivision NEE), and the
 //! `moment` wrapper that also outputs the per-pixel second moment.
 
 pub mod path;
@@ -9,6 +9,7 @@ pub mod volpathmis;
 
 use crate::scene::desc::{ObjectDesc, PluginKind};
 use crate::scene::{Error, Result};
+use snee::{SneeOptions, SneeTechnique, SneeTransport};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum IntegratorKind {
@@ -28,11 +29,20 @@ pub struct IntegratorDesc {
     pub hide_emitters: bool,
     /// Wrapped in `moment`: also output the per-pixel second moment.
     pub moment: bool,
+    /// `volpath_snee`'s `snee` and `transport` options (defaults elsewhere).
+    pub snee: SneeOptions,
 }
 
 impl Default for IntegratorDesc {
     fn default() -> Self {
-        IntegratorDesc { kind: IntegratorKind::Path, max_depth: -1, rr_depth: 5, hide_emitters: false, moment: false }
+        IntegratorDesc {
+            kind: IntegratorKind::Path,
+            max_depth: -1,
+            rr_depth: 5,
+            hide_emitters: false,
+            moment: false,
+            snee: SneeOptions::default(),
+        }
     }
 }
 
@@ -76,6 +86,28 @@ impl IntegratorDesc {
             return Err(props.error("rr_depth", "rr_depth must be positive"));
         }
         let hide_emitters = props.bool("hide_emitters", false)?;
+        let mut snee = SneeOptions::default();
+        if kind == IntegratorKind::VolpathSnee {
+            snee.technique = match props.string("snee", "mis")?.as_str() {
+                "mis" => SneeTechnique::Mis,
+                "snee" => SneeTechnique::Snee,
+                "forward" => SneeTechnique::Forward,
+                other => {
+                    return Err(props
+                        .error("snee", format!("volpath_snee: snee = \"{}\" is not one of mis, snee, forward", other)))
+                }
+            };
+            snee.transport = match props.string("transport", "all")?.as_str() {
+                "all" => SneeTransport::All,
+                "snee" => SneeTransport::Snee,
+                other => {
+                    return Err(props.error(
+                        "transport",
+                        format!("volpath_snee: transport = \"{}\" is not one of all, snee", other),
+                    ))
+                }
+            };
+        }
         props.finish()?;
         let clamp = |v: i64| v.clamp(-1, i32::MAX as i64) as i32;
         Ok(IntegratorDesc {
@@ -84,6 +116,7 @@ impl IntegratorDesc {
             rr_depth: clamp(rr_depth),
             hide_emitters,
             moment: false,
+            snee,
         })
     }
 }

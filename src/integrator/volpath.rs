@@ -15,6 +15,7 @@
 //! - "Specular chains" (paths whose last non-null event was a delta lobe, or a medium vertex that
 //!   does not sample emitters) count an emitter they hit at full weight.
 
+use super::snee::{self, ForwardTechnique, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
 use super::stats::LocalStats;
 use crate::bsdf::{flags, BsdfContext};
 use crate::color::Spectrum;
@@ -158,6 +159,48 @@ pub fn li(
     medium: Option<u32>,
     stats: &mut LocalStats,
 ) -> (Spectrum, bool) {
+    li_with(scene, sampler, ray, medium, stats, None)
+}
+
+/// The weight of a forward contribution that may end a SNEE suffix (docs/snee.md §3): volpath's
+/// `w_volpath` without SNEE; otherwise the joint MIS weight for suffixes in SNEE's support, and
+/// `w_volpath` (transport = all) or 0 (transport = snee) for the others.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn suffix_weight(
+    scene: &Scene,
+    snee: Option<SneeOptions>,
+    suffix: Option<&SneeSuffix>,
+    light: impl FnOnce() -> LightSample,
+    technique: ForwardTechnique,
+    w_volpath: f32,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> f32 {
+    let Some(opts) = snee else { return w_volpath };
+    let w = match suffix {
+        Some(s) if opts.needs_suffix_pdf() => {
+            snee::forward_weight(scene, opts, s, &light(), technique, w_volpath, channel, stats)
+        }
+        _ => None,
+    };
+    match w {
+        Some(w) => w,
+        None if opts.keeps_all() => w_volpath,
+        None => 0.0,
+    }
+}
+
+/// volpath's loop; with `snee`, the `volpath_snee` integrator (SNEE as one stage, and the MIS
+/// weights of forward suffixes that SNEE can also produce). With `None` this is Mitsuba's volpath.
+pub fn li_with(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    ray: Ray,
+    medium: Option<u32>,
+    stats: &mut LocalStats,
+    snee: Option<SneeOptions>,
+) -> (Spectrum, bool) {
     let desc = &scene.integrator;
     let max_depth = if desc.max_depth < 0 { u32::MAX } else { desc.max_depth as u32 };
     let rr_depth = desc.rr_depth as u32;
@@ -178,6 +221,16 @@ pub fn li(
     // The surface hit along the current ray, when already traced.
     let mut si: Option<SurfaceInteraction> = None;
     let mut needs_intersection = true;
+    // ---- SNEE state (docs/snee.md §3) ----
+    // Contributions outside SNEE's suffixes are dropped with transport = snee.
+    let keep_all = snee.is_none_or(|o| o.keeps_all());
+    // x_i: the last real scatter, when SNEE runs there and no surface event followed.
+    let mut snee_x_i: Option<SneeVertex> = None;
+    // (x_i, x_j): the scatter x_j directly after a SNEE vertex x_i.
+    let mut snee_chain: Option<(SneeVertex, Vec3)> = None;
+    // The suffix x_i → x_j → x_k at the current boundary vertex, and after BSDF sampling there.
+    let mut snee_at_k: Option<SneeSuffix>;
+    let mut snee_pending: Option<SneeSuffix> = None;
 
     loop {
         // ---- Russian roulette and depth limit ----
@@ -236,10 +289,19 @@ pub fn li(
                 specular_chain = !m.sample_emitters;
                 if m.sample_emitters {
                     let (emitted, ds) = sample_emitter(scene, RefPoint::Medium(p), medium, channel, sampler, stats);
-                    if emitted != Spectrum::ZERO {
+                    if emitted != Spectrum::ZERO && keep_all {
                         let phase_val = m.phase.eval(wi, ds.d);
                         let w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { phase_val });
                         result += w * beta * phase_val * emitted;
+                    }
+                }
+
+                // ---- Subdivision next-event estimation (volpath_snee) ----
+                if let Some(opts) = snee {
+                    snee_chain = snee_x_i.take().map(|x_i| (x_i, p));
+                    snee_x_i = snee::snee_vertex(scene, mi, p, wi, depth, max_depth);
+                    if let (Some(x_i), true) = (&snee_x_i, opts.technique != SneeTechnique::Forward) {
+                        result += snee::sample(scene, x_i, beta, channel, opts.technique, sampler, stats);
                     }
                 }
 
@@ -263,6 +325,15 @@ pub fn li(
             si = scene.ray_intersect(&ray);
         }
         needs_intersection = true;
+        // A surface event ends SNEE chains; it is x_k when it follows x_i → x_j on an enclosing boundary.
+        snee_x_i = None;
+        snee_at_k = match (snee_chain.take(), &si) {
+            (Some((x_i, x_j)), Some(s)) if snee::encloses(scene, s, x_i.medium, ray.d) => {
+                Some(SneeSuffix { x_i, x_j, si_k: *s })
+            }
+            _ => None,
+        };
+        let pending = snee_pending.take();
 
         // ---- Emitters hit by the ray (area lights, or the environment on escape) ----
         let count_direct = depth == 0 || specular_chain;
@@ -278,6 +349,27 @@ pub fn li(
                             let ds = scene.direction_sample_for_hit(last_scatter_p, s);
                             mis_weight(last_scatter_pdf, scene.pdf_emitter_direction(last_scatter_p, &ds))
                         };
+                        let light = || {
+                            let ds = scene.direction_sample_for_hit(last_scatter_p, s);
+                            LightSample {
+                                omega_l: ray.d,
+                                p: s.p,
+                                dist: ds.dist,
+                                p_light: scene.pdf_emitter_direction(last_scatter_p, &ds),
+                                delta: false,
+                                le: Spectrum::ZERO,
+                            }
+                        };
+                        let w = suffix_weight(
+                            scene,
+                            snee,
+                            pending.as_ref(),
+                            light,
+                            ForwardTechnique::Bsdf,
+                            w,
+                            channel,
+                            stats,
+                        );
                         result += beta * le * w;
                     }
                 }
@@ -290,6 +382,27 @@ pub fn li(
                             let ds = scene.environment_direction_sample(env, ray.d);
                             mis_weight(last_scatter_pdf, scene.pdf_emitter_direction(last_scatter_p, &ds))
                         };
+                        let light = || {
+                            let ds = scene.environment_direction_sample(env, ray.d);
+                            LightSample {
+                                omega_l: ray.d,
+                                p: last_scatter_p,
+                                dist: f32::INFINITY,
+                                p_light: scene.pdf_emitter_direction(last_scatter_p, &ds),
+                                delta: false,
+                                le: Spectrum::ZERO,
+                            }
+                        };
+                        let w = suffix_weight(
+                            scene,
+                            snee,
+                            pending.as_ref(),
+                            light,
+                            ForwardTechnique::Bsdf,
+                            w,
+                            channel,
+                            stats,
+                        );
                         result += beta * le * w;
                     }
                 }
@@ -305,7 +418,17 @@ pub fn li(
             if emitted != Spectrum::ZERO {
                 let wo = s.to_local(ds.d);
                 let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &s, wo);
-                result += beta * bsdf_val * mis_weight(ds.pdf, if ds.delta { 0.0 } else { bsdf_pdf }) * emitted;
+                let w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { bsdf_pdf });
+                let light = || LightSample {
+                    omega_l: ds.d,
+                    p: ds.p,
+                    dist: ds.dist,
+                    p_light: ds.pdf,
+                    delta: ds.delta,
+                    le: Spectrum::ZERO,
+                };
+                let w = suffix_weight(scene, snee, snee_at_k.as_ref(), light, ForwardTechnique::Nee, w, channel, stats);
+                result += beta * bsdf_val * w * emitted;
             }
         }
 
@@ -321,6 +444,12 @@ pub fn li(
         let wo = s.to_world(bs.wo);
         ray = s.spawn_ray(wo);
         let non_null = bs.sampled_type & flags::NULL == 0;
+        if bs.sampled_type & flags::TRANSMISSION != 0 && non_null && wo.dot(s.n) > 0.0 {
+            snee_pending = snee_at_k;
+        } else if !non_null && snee::passable(scene, &s) {
+            // A light segment x_k → emitter may cross passable interfaces (docs/snee.md §1).
+            snee_pending = pending;
+        }
         if non_null {
             depth += 1;
             last_scatter_p = s.p;

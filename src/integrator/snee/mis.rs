@@ -1,0 +1,60 @@
+//! MIS between SNEE and forward path tracing for a path suffix `x_i → x_j → x_k → emitter`
+//! (docs/snee.md §3): one weight function, called with the same densities whichever technique
+//! produced the path.
+
+use super::SneeTechnique;
+
+/// Densities of one suffix under every technique, in the common measure of docs/snee.md §1.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SuffixPdfs {
+    /// `pdf_snee` (0 outside SNEE's support).
+    pub snee: f64,
+    /// `p_fwd · p_light(omega_l)`: forward NEE at a rough `x_k` (0 at a smooth one).
+    pub fwd_nee: f64,
+    /// `p_fwd · bsdf.pdf(omega_kj → omega_l)` at a rough `x_k`, `p_fwd · (1 − F)` at a smooth one
+    /// (0 for delta emitters, which cannot be hit).
+    pub fwd_bsdf: f64,
+}
+
+/// MIS weights of the three techniques; they sum to 1 whenever some density is positive.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SuffixWeights {
+    pub snee: f64,
+    pub fwd_nee: f64,
+    pub fwd_bsdf: f64,
+}
+
+/// Power heuristic over all techniques (`snee = mis`), SNEE alone where it can produce the
+/// suffix (`snee = snee`), or forward alone (`snee = forward`, SNEE's density taken as 0).
+pub fn suffix_weights(technique: SneeTechnique, p: SuffixPdfs) -> SuffixWeights {
+    let snee = match technique {
+        SneeTechnique::Forward => 0.0,
+        _ => p.snee,
+    };
+    if technique == SneeTechnique::Snee && snee > 0.0 {
+        return SuffixWeights { snee: 1.0, fwd_nee: 0.0, fwd_bsdf: 0.0 };
+    }
+    let (a, b, c) = (snee * snee, p.fwd_nee * p.fwd_nee, p.fwd_bsdf * p.fwd_bsdf);
+    let sum = a + b + c;
+    if !(sum > 0.0) || !sum.is_finite() {
+        return SuffixWeights::default();
+    }
+    SuffixWeights { snee: a / sum, fwd_nee: b / sum, fwd_bsdf: c / sum }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weights_partition_unity() {
+        let p = SuffixPdfs { snee: 3.0, fwd_nee: 1.0, fwd_bsdf: 2.0 };
+        let w = suffix_weights(SneeTechnique::Mis, p);
+        assert!((w.snee + w.fwd_nee + w.fwd_bsdf - 1.0).abs() < 1e-12);
+        assert!((w.snee - 9.0 / 14.0).abs() < 1e-12);
+        let w = suffix_weights(SneeTechnique::Snee, p);
+        assert_eq!(w, SuffixWeights { snee: 1.0, fwd_nee: 0.0, fwd_bsdf: 0.0 });
+        let w = suffix_weights(SneeTechnique::Forward, p);
+        assert!((w.fwd_nee - 0.2).abs() < 1e-12 && w.snee == 0.0);
+    }
+}

@@ -1,0 +1,175 @@
+//! Helpers shared by the `snee_*` tests: scenes from XML text, renders in independent batches,
+//! and a Welch t-test on batch means with Šidák's correction.
+#![allow(dead_code, clippy::needless_range_loop)]
+
+use snee::render::{render, RenderOptions};
+use snee::scene::build::build_scene;
+use snee::scene::world::Scene;
+use snee::scene::xml::parse_str;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Build a scene from XML text (assets resolve against `scenes/`).
+pub fn scene(xml: &str, defines: &[(&str, &str)]) -> Scene {
+    let defines: Vec<(String, String)> = defines.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect();
+    let parsed = parse_str(xml, "test.xml", &root().join("scenes"), &defines).unwrap_or_else(|e| panic!("{}", e));
+    build_scene(&parsed).unwrap_or_else(|e| panic!("{}", e))
+}
+
+/// Per-batch statistics of a render: mean over the image and over `block`×`block` blocks, RGB.
+pub struct Batches {
+    /// [batch][statistic][channel]; statistic 0 = image mean, then the blocks.
+    pub stats: Vec<Vec<[f64; 3]>>,
+    pub rejected: u64,
+    pub rays: u64,
+}
+
+pub fn render_batches(scene: &Scene, batches: usize, spp: u32, block: usize, seed0: u64) -> Batches {
+    let cancel = AtomicBool::new(false);
+    let mut out = Batches { stats: Vec::new(), rejected: 0, rays: 0 };
+    for b in 0..batches {
+        let opts = RenderOptions { spp: Some(spp), seed: seed0 + b as u64, time_budget: None, progress: false };
+        let img = render(scene, &opts, &cancel);
+        out.rejected += img.stats.rejected_samples;
+        out.rays += img.stats.rays;
+        let (w, h, nch) = (img.width, img.height, img.channels.len());
+        let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
+        let mut s = vec![[0.0f64; 3]; 1 + bw * bh];
+        let mut n = vec![0usize; 1 + bw * bh];
+        for y in 0..h {
+            for x in 0..w {
+                let k = 1 + (y / block) * bw + x / block;
+                for c in 0..3 {
+                    let v = img.data[(y * w + x) * nch + c] as f64;
+                    assert!(v.is_finite(), "non-finite pixel");
+                    s[0][c] += v;
+                    s[k][c] += v;
+                }
+                n[0] += 1;
+                n[k] += 1;
+            }
+        }
+        for (si, ni) in s.iter_mut().zip(&n) {
+            for v in si.iter_mut() {
+                *v /= *ni as f64;
+            }
+        }
+        out.stats.push(s);
+    }
+    out
+}
+
+fn ln_gamma(x: f64) -> f64 {
+    // Lanczos (g = 7, n = 9).
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    let x = x - 1.0;
+    let t = x + 7.5;
+    let a = C.iter().enumerate().skip(1).fold(C[0], |a, (i, c)| a + c / (x + i as f64));
+    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// Regularized incomplete beta I_x(a, b) (continued fraction, Lentz).
+fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let bt = (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
+    if x > (a + 1.0) / (a + b + 2.0) {
+        return 1.0 - incomplete_beta(b, a, 1.0 - x);
+    }
+    let (mut c, mut d) = (1.0f64, 1.0 - (a + b) * x / (a + 1.0));
+    d = 1.0 / if d.abs() < 1e-300 { 1e-300 } else { d };
+    let mut h = d;
+    for m in 1..300 {
+        let m = m as f64;
+        for k in 0..2 {
+            let num = if k == 0 {
+                m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m))
+            } else {
+                -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0))
+            };
+            d = 1.0 + num * d;
+            d = 1.0 / if d.abs() < 1e-300 { 1e-300 } else { d };
+            c = 1.0 + num / c;
+            if c.abs() < 1e-300 {
+                c = 1e-300;
+            }
+            h *= d * c;
+        }
+        if (d * c - 1.0).abs() < 1e-14 {
+            break;
+        }
+    }
+    bt * h / a
+}
+
+/// Two-sided p-value of Student's t with `dof` degrees of freedom.
+pub fn t_p_value(t: f64, dof: f64) -> f64 {
+    incomplete_beta(0.5 * dof, 0.5, dof / (dof + t * t))
+}
+
+fn mean_var(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    (m, v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0))
+}
+
+/// Welch's test of equal means of every statistic and channel, Šidák-corrected at `alpha`.
+/// Returns a report of the failures (empty when all pass) and the image means.
+pub fn welch_compare(a: &Batches, b: &Batches, alpha: f64) -> (String, [f64; 3], [f64; 3]) {
+    let n_stats = a.stats[0].len();
+    let tests = n_stats * 3;
+    let level = 1.0 - (1.0 - alpha).powf(1.0 / tests as f64);
+    let mut report = String::new();
+    let mut means = ([0.0; 3], [0.0; 3]);
+    for s in 0..n_stats {
+        for c in 0..3 {
+            let va: Vec<f64> = a.stats.iter().map(|x| x[s][c]).collect();
+            let vb: Vec<f64> = b.stats.iter().map(|x| x[s][c]).collect();
+            let ((ma, sa), (mb, sb)) = (mean_var(&va), mean_var(&vb));
+            if s == 0 {
+                means.0[c] = ma;
+                means.1[c] = mb;
+            }
+            let (qa, qb) = (sa / va.len() as f64, sb / vb.len() as f64);
+            let se2 = qa + qb;
+            if se2 == 0.0 {
+                if ma != mb {
+                    report += &format!("stat {} ch {}: {} vs {} with zero variance\n", s, c, ma, mb);
+                }
+                continue;
+            }
+            let t = (ma - mb) / se2.sqrt();
+            let dof = se2 * se2 / (qa * qa / (va.len() as f64 - 1.0) + qb * qb / (vb.len() as f64 - 1.0)).max(1e-300);
+            let p = t_p_value(t.abs(), dof.max(1.0));
+            if p < level {
+                report += &format!("stat {} ch {}: {:.6} vs {:.6} (t = {:.2}, p = {:.2e})\n", s, c, ma, mb, t, p);
+            }
+        }
+    }
+    (report, means.0, means.1)
+}
+
+/// Relative standard error of the image mean (channel-averaged) of a batch set.
+pub fn rel_std_error(a: &Batches) -> f64 {
+    let v: Vec<f64> = a.stats.iter().map(|x| (x[0][0] + x[0][1] + x[0][2]) / 3.0).collect();
+    let (m, var) = mean_var(&v);
+    (var / v.len() as f64).sqrt() / m.abs().max(1e-300)
+}
