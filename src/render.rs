@@ -47,6 +47,8 @@ pub struct RenderStats {
     pub samples: u64,
     pub rays: u64,
     pub rejected_samples: u64,
+    pub snee_attempts: u64,
+    pub snee_probe_failures: u64,
 }
 
 impl RenderStats {
@@ -59,6 +61,8 @@ impl RenderStats {
             "rays": self.rays,
             "rays_per_second": self.rays as f64 / self.seconds.max(1e-9),
             "rejected_samples": self.rejected_samples,
+            "snee_attempts": self.snee_attempts,
+            "snee_probe_failures": self.snee_probe_failures,
         })
     }
 }
@@ -219,6 +223,8 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
             samples: samples_done,
             rays: stats.rays.load(Ordering::Relaxed),
             rejected_samples: stats.rejected_samples.load(Ordering::Relaxed),
+            snee_attempts: stats.snee_attempts.load(Ordering::Relaxed),
+            snee_probe_failures: stats.snee_probe_failures.load(Ordering::Relaxed),
         },
     }
 }

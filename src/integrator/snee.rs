@@ -347,14 +347,18 @@ fn sample_impl(
     let st = m.sigma_t[channel];
 
     // ---- Probe: x_k (Eq. 5) ----
+    stats.snee_attempts += 1;
     let omega_ik = warp::square_to_uniform_sphere(u_probe);
     stats.rays += 1;
-    let Some(si_k) = scene.ray_intersect(&Ray::new(x_i.p, omega_ik)) else { return Spectrum::ZERO };
-    if !encloses(scene, &si_k, x_i.medium, omega_ik) {
+    let probe = scene
+        .ray_intersect(&Ray::new(x_i.p, omega_ik))
+        .filter(|si_k| encloses(scene, si_k, x_i.medium, omega_ik))
+        .and_then(|si_k| Boundary::of(scene.bsdf(&si_k)).map(|b| (si_k, b)));
+    let Some((si_k, boundary)) = probe else {
+        stats.snee_probe_failures += 1;
         return Spectrum::ZERO;
-    }
+    };
     let bsdf = scene.bsdf(&si_k);
-    let Some(boundary) = Boundary::of(bsdf) else { return Spectrum::ZERO };
     let (c_down, _) = mixture(scene, boundary);
     let down = u_strategy < c_down;
 
