@@ -81,7 +81,9 @@ fn sample_li(scene: &Scene, sampler: &mut Sampler, ray: crate::math::Ray, stats:
 /// Refuse integrators that are parsed but not implemented yet (never render something else silently).
 pub fn check_renderable(scene: &Scene) -> Result<(), String> {
     match scene.integrator.kind {
-        IntegratorKind::Path | IntegratorKind::Volpath | IntegratorKind::VolpathSnee => Ok(()),
+        IntegratorKind::Path | IntegratorKind::Volpath | IntegratorKind::Volpathmis | IntegratorKind::VolpathSnee => {
+            Ok(())
+        }
         other => Err(format!("integrator {:?} is recognised but not implemented yet (use path or volpath)", other)),
     }
 }

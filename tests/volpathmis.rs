@@ -146,15 +146,18 @@ fn render(scene: &Scene, integrator: Integrator, spp_per_batch: u32, seed: u64) 
                 let ray = scene.camera.sample_ray(pos, aperture);
                 let (l, _) = match integrator {
                     Integrator::Volpath => volpath::li(scene, &mut sampler, ray, scene.sensor_medium, &mut stats),
-                    Integrator::Volpathmis => volpathmis::li(scene, &mut sampler, ray, scene.sensor_medium, &mut stats),
-                    Integrator::VolpathmisUnbiased => volpathmis::li_with(
+                    Integrator::Volpathmis => volpathmis::li_with(
                         scene,
                         &mut sampler,
                         ray,
                         scene.sensor_medium,
                         &mut stats,
-                        RouletteMis::Unbiased,
+                        RouletteMis::Mitsuba,
                     ),
+                    // What `snee render` uses.
+                    Integrator::VolpathmisUnbiased => {
+                        volpathmis::li(scene, &mut sampler, ray, scene.sensor_medium, &mut stats)
+                    }
                 };
                 let l = if l.is_finite() {
                     l
@@ -510,8 +513,8 @@ fn zero_sigma_channel_in_unbounded_medium() {
 const MITSUBA_RR_VOLPATHMIS: ([f64; 3], [f64; 3]) = ([0.250280, 0.226437, 0.265673], [0.0000240, 0.0000193, 0.0000292]);
 const MITSUBA_RR_VOLPATH: ([f64; 3], [f64; 3]) = ([0.254781, 0.229848, 0.270871], [0.0000256, 0.0000203, 0.0000311]);
 
-/// Our `li` reproduces Mitsuba's volpathmis including that bias, the test resolves the bias, and
-/// `RouletteMis::Unbiased` agrees with volpath.
+/// `RouletteMis::Mitsuba` reproduces Mitsuba's volpathmis including that bias, the test resolves
+/// the bias, and our `li` (`RouletteMis::Unbiased`) agrees with volpath.
 #[test]
 fn roulette_bias_is_mitsubas() {
     let scene = load(&scene_xml(

@@ -215,7 +215,8 @@ pub enum RouletteMis {
 }
 
 /// Radiance along a camera ray starting in `medium`; also whether the ray is "valid" (alpha).
-/// Mitsuba's estimator, including its roulette weighting ([`RouletteMis::Mitsuba`]).
+/// Mitsuba's estimator with its roulette weighting fixed ([`RouletteMis::Unbiased`]): the same
+/// expectation as `volpath`, which Mitsuba 3.9's volpathmis misses by ~0.1 % (`rr_depth` 5).
 pub fn li(
     scene: &Scene,
     sampler: &mut Sampler,
@@ -223,7 +224,7 @@ pub fn li(
     medium: Option<u32>,
     stats: &mut LocalStats,
 ) -> (Spectrum, bool) {
-    li_with(scene, sampler, ray, medium, stats, RouletteMis::Mitsuba)
+    li_with(scene, sampler, ray, medium, stats, RouletteMis::Unbiased)
 }
 
 /// [`li`] with a choice of how Russian roulette enters the MIS weights.
