@@ -133,7 +133,6 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let defines = parse_defines(&define)?;
             let mut loaded = load_scene(&scene_path, &defines)?;
             loaded.integrator.moment |= moment;
-            snee::render::check_renderable(&loaded).map_err(|e| anyhow!("{}: {}", scene_path.display(), e))?;
             if let Some(t) = time {
                 if !(t > 0.0 && t.is_finite()) {
                     return Err(anyhow!("--time expects a positive number of seconds"));

@@ -78,16 +78,6 @@ fn sample_li(scene: &Scene, sampler: &mut Sampler, ray: crate::math::Ray, stats:
     }
 }
 
-/// Refuse integrators that are parsed but not implemented yet (never render something else silently).
-pub fn check_renderable(scene: &Scene) -> Result<(), String> {
-    match scene.integrator.kind {
-        IntegratorKind::Path | IntegratorKind::Volpath | IntegratorKind::Volpathmis | IntegratorKind::VolpathSnee => {
-            Ok(())
-        }
-        other => Err(format!("integrator {:?} is recognised but not implemented yet (use path or volpath)", other)),
-    }
-}
-
 /// Render the scene. `cancel` stops early (Ctrl-C); the samples done so far are kept.
 pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> RenderOutput {
     let film = &scene.film;
