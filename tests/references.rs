@@ -22,6 +22,7 @@ use snee::compare::erfc;
 use snee::io::read::read_image;
 use snee::render::{render, RenderOptions};
 use snee::scene::build::load_scene;
+use snee::testing::student_t::t_p_value;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
@@ -39,81 +40,6 @@ struct Image {
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// Student-t two-sided p-value with `dof` degrees of freedom (via the regularized incomplete beta).
-fn t_p_value(t: f64, dof: f64) -> f64 {
-    let x = dof / (dof + t * t);
-    incomplete_beta(0.5 * dof, 0.5, x)
-}
-
-fn ln_gamma(x: f64) -> f64 {
-    // Lanczos approximation (g = 7, n = 9).
-    const C: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    let x = x - 1.0;
-    let mut a = C[0];
-    let t = x + 7.5;
-    for (i, c) in C.iter().enumerate().skip(1) {
-        a += c / (x + i as f64);
-    }
-    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
-}
-
-/// Regularized incomplete beta I_x(a, b) (Numerical Recipes' continued fraction).
-fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    if x >= 1.0 {
-        return 1.0;
-    }
-    let bt = (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
-    let cf = |a: f64, b: f64, x: f64| {
-        let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
-        let mut c = 1.0;
-        let mut d = 1.0 - qab * x / qap;
-        d = if d.abs() < 1e-300 { 1e-300 } else { d };
-        d = 1.0 / d;
-        let mut h = d;
-        for m in 1..300 {
-            let m = m as f64;
-            let m2 = 2.0 * m;
-            let aa = m * (b - m) * x / ((qam + m2) * (a + m2));
-            d = 1.0 + aa * d;
-            d = if d.abs() < 1e-300 { 1e-300 } else { d };
-            c = 1.0 + aa / c;
-            c = if c.abs() < 1e-300 { 1e-300 } else { c };
-            d = 1.0 / d;
-            h *= d * c;
-            let aa = -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2));
-            d = 1.0 + aa * d;
-            d = if d.abs() < 1e-300 { 1e-300 } else { d };
-            c = 1.0 + aa / c;
-            c = if c.abs() < 1e-300 { 1e-300 } else { c };
-            d = 1.0 / d;
-            let del = d * c;
-            h *= del;
-            if (del - 1.0).abs() < 1e-12 {
-                break;
-            }
-        }
-        h
-    };
-    if x < (a + 1.0) / (a + b + 2.0) {
-        bt * cf(a, b, x) / a
-    } else {
-        1.0 - bt * cf(b, a, 1.0 - x) / b
-    }
 }
 
 fn sidak(alpha: f64, n: usize) -> f64 {

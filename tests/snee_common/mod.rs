@@ -6,6 +6,7 @@ use snee::render::{render, RenderOptions};
 use snee::scene::build::build_scene;
 use snee::scene::world::Scene;
 use snee::scene::xml::parse_str;
+pub use snee::testing::student_t::t_p_value;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
@@ -61,68 +62,6 @@ pub fn render_batches(scene: &Scene, batches: usize, spp: u32, block: usize, see
         out.stats.push(s);
     }
     out
-}
-
-fn ln_gamma(x: f64) -> f64 {
-    // Lanczos (g = 7, n = 9).
-    const C: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    let x = x - 1.0;
-    let t = x + 7.5;
-    let a = C.iter().enumerate().skip(1).fold(C[0], |a, (i, c)| a + c / (x + i as f64));
-    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
-}
-
-/// Regularized incomplete beta I_x(a, b) (continued fraction, Lentz).
-fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    if x >= 1.0 {
-        return 1.0;
-    }
-    let bt = (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
-    if x > (a + 1.0) / (a + b + 2.0) {
-        return 1.0 - incomplete_beta(b, a, 1.0 - x);
-    }
-    let (mut c, mut d) = (1.0f64, 1.0 - (a + b) * x / (a + 1.0));
-    d = 1.0 / if d.abs() < 1e-300 { 1e-300 } else { d };
-    let mut h = d;
-    for m in 1..300 {
-        let m = m as f64;
-        for k in 0..2 {
-            let num = if k == 0 {
-                m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m))
-            } else {
-                -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0))
-            };
-            d = 1.0 + num * d;
-            d = 1.0 / if d.abs() < 1e-300 { 1e-300 } else { d };
-            c = 1.0 + num / c;
-            if c.abs() < 1e-300 {
-                c = 1e-300;
-            }
-            h *= d * c;
-        }
-        if (d * c - 1.0).abs() < 1e-14 {
-            break;
-        }
-    }
-    bt * h / a
-}
-
-/// Two-sided p-value of Student's t with `dof` degrees of freedom.
-pub fn t_p_value(t: f64, dof: f64) -> f64 {
-    incomplete_beta(0.5 * dof, 0.5, dof / (dof + t * t))
 }
 
 fn mean_var(v: &[f64]) -> (f64, f64) {
