@@ -76,6 +76,13 @@ DEFAULT_SPP = {
     "directional_area": 16384,
     "spot_point": 16384,
     "default": 12288,
+    "media_smooth_glass": 16384,
+    "media_rough_glass": 12288,
+    "media_null": 16384,
+    "media_inside": 16384,
+    "media_thin": 16384,
+    "media_spot": 16384,
+    "media_camera_inside": 16384,
 }
 FALLBACK_SPP = 4096
 MAX_SAMPLES_PER_PASS = 1 << 22

@@ -315,3 +315,51 @@ fn rough_glass_ggx() {
 fn spot_point() {
     check_scene("spot_point", 64, true);
 }
+
+// Media scenes (volpath). Per-pixel tests only where Mitsuba's own renders pass this very test
+// (`scripts/self_test.py`, 16 x 16 spp against the reference: media_null and media_camera_inside
+// 0 failures in 15 trials; media_inside failed the per-pixel test in 2 of 15, so blocks only).
+// Light that reaches a medium only through glass makes pixel values heavy-tailed (reference/README.md).
+
+// Ignored: fails at 16 x 16 spp on a heavy-tailed block (block 65, G: ours 0.1892 vs ref 0.2194,
+// -13.8 %, p = 3.01e-5 < 3.07e-5). The sun is reached from the medium only by refracting out of the
+// smooth glass, so a few rare samples carry most of the light. Not a visible bias: at 2048 spp our
+// image mean is -0.14/-0.12/-0.09 % (R/G/B) from the reference and 8x8 block z-scores have std 0.81,
+// max 3.8. Mitsuba itself fails this test in 2 of 5 trials (`scripts/self_test.py`).
+#[test]
+#[ignore = "heavy-tailed (sun through smooth glass): fails at 256 spp, no bias at 2048 spp"]
+fn media_smooth_glass() {
+    check_scene("media_smooth_glass", 16, false);
+}
+#[test]
+fn media_rough_glass() {
+    check_scene("media_rough_glass", 16, false);
+}
+#[test]
+fn media_null() {
+    check_scene("media_null", 16, true);
+}
+#[test]
+fn media_inside() {
+    check_scene("media_inside", 16, false);
+}
+#[test]
+fn media_thin() {
+    check_scene("media_thin", 16, false);
+}
+// Ignored: fails at 16 x 16 spp (block 31, B: ours 0.0321 vs ref 0.0363, -11.7 %, p = 1.1e-5 <
+// 3.07e-5) and worse at 16 x 32 spp (block 58, R: -19.9 %, p = 2.1e-7). Light enters the medium
+// only by emitter sampling at the Beckmann (alpha 0.1) boundary, a narrow lobe: the pixel values
+// are firefly-dominated (two Mitsuba renders at 256 spp: per-pixel max |z| = 62, 219 pixel-channels
+// over the Sidak level, `make_references.py --check 256`), and Mitsuba fails this test in 5 of 5 trials
+// (`scripts/self_test.py`). At 2048 spp our image mean is -1.1/-0.9/-0.6 % from the reference,
+// z = -1.4 (not significant).
+#[test]
+#[ignore = "firefly-dominated (spot through Beckmann 0.1 glass): fails at 256 spp, no significant bias at 2048 spp"]
+fn media_spot() {
+    check_scene("media_spot", 16, false);
+}
+#[test]
+fn media_camera_inside() {
+    check_scene("media_camera_inside", 16, true);
+}
