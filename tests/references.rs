@@ -327,9 +327,9 @@ fn spot_point() {
 // image mean is -0.14/-0.12/-0.09 % (R/G/B) from the reference and 8x8 block z-scores have std 0.81,
 // max 3.8. Mitsuba itself fails this test in 2 of 5 trials (`scripts/self_test.py`).
 #[test]
-#[ignore = "heavy-tailed (sun through smooth glass): fails at 256 spp, no bias at 2048 spp"]
+// Heavy-tailed (sun through smooth glass): fails at 256 spp, so 16 × 128 spp here.
 fn media_smooth_glass() {
-    check_scene("media_smooth_glass", 16, false);
+    check_scene("media_smooth_glass", 128, false);
 }
 #[test]
 fn media_rough_glass() {
@@ -355,9 +355,9 @@ fn media_thin() {
 // (`scripts/self_test.py`). At 2048 spp our image mean is -1.1/-0.9/-0.6 % from the reference,
 // z = -1.4 (not significant).
 #[test]
-#[ignore = "firefly-dominated (spot through Beckmann 0.1 glass): fails at 256 spp, no significant bias at 2048 spp"]
+// Firefly-dominated (spot through Beckmann 0.1 glass): fails at 256 spp, so 16 × 128 spp here.
 fn media_spot() {
-    check_scene("media_spot", 16, false);
+    check_scene("media_spot", 128, false);
 }
 #[test]
 fn media_camera_inside() {
