@@ -32,7 +32,7 @@ import numpy as np
 RINGS = 322  # rings of the surface of revolution (including the two pole rings)
 SEGMENTS = 194  # vertices around each ring
 SUN_ELEVATION_DEG = 55.0
-SUN_AZIMUTH_DEG = 35.0  # phi = 2*pi*u, measured from -Z towards +X (Mitsuba's envmap u)
+SUN_AZIMUTH_DEG = 150.0  # phi = 2*pi*u, measured from -Z towards +X: in front of the camera, to the right
 SUN_RADIUS_DEG = 2.0
 SUN_RADIANCE = np.array([1500.0, 1400.0, 1250.0])
 
