@@ -130,13 +130,22 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
     let mut pass = 0u64;
     let mut samples_done = 0u64;
     while spp_done < total_spp && !cancel.load(Ordering::Relaxed) {
+        // Passes double in size (1, 2, 4, ... 64 spp); with a time budget, a pass is cut to what
+        // the measured rate says fits in the remaining time, and none starts that would end
+        // more than half a sample per pixel past the budget.
+        let mut pass_spp = (1u32 << pass.min(6)).min(total_spp - spp_done);
         if let Some(t) = opts.time_budget {
-            if spp_done > 0 && start.elapsed().as_secs_f64() >= t {
-                break;
+            let elapsed = start.elapsed().as_secs_f64();
+            if spp_done > 0 {
+                let per_spp = elapsed / spp_done as f64;
+                let remaining = t - elapsed;
+                if remaining < 0.5 * per_spp {
+                    break;
+                }
+                let fits = (remaining / per_spp).round().max(1.0);
+                pass_spp = pass_spp.min(fits.min(u32::MAX as f64) as u32);
             }
         }
-        // Passes double in size (1, 2, 4, ... 64 spp) so a time budget is met closely.
-        let pass_spp = (1u32 << pass.min(6)).min(total_spp - spp_done);
         let first_sample = spp_done;
         let completed = std::sync::atomic::AtomicU64::new(0);
         // Tiles render in parallel; their blocks merge in tile order so the floating-point sums (and
