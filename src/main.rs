@@ -67,6 +67,12 @@ enum Command {
         /// Also write the per-pixel second moment (channels m2.R, m2.G, m2.B), as Mitsuba's `moment`.
         #[arg(long)]
         moment: bool,
+        /// Reference image for --convergence.
+        #[arg(long, value_name = "REF.exr", requires = "convergence")]
+        reference: Option<PathBuf>,
+        /// Write (seconds, spp, relMSE against --reference) at doubling sample counts as CSV.
+        #[arg(long, value_name = "FILE.csv", requires = "reference")]
+        convergence: Option<PathBuf>,
     },
     /// Compare two EXR images: MSE, relMSE, mean ratio, and a per-pixel Z-test when variances are present.
     Compare {
@@ -124,7 +130,21 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Render { scene, output, define, spp, seed, threads, time, stats, png, quiet, moment } => {
+        Command::Render {
+            scene,
+            output,
+            define,
+            spp,
+            seed,
+            threads,
+            time,
+            stats,
+            png,
+            quiet,
+            moment,
+            reference,
+            convergence,
+        } => {
             // Before loading: building the BVH already starts rayon's global pool.
             if let Some(t) = threads {
                 rayon::ThreadPoolBuilder::new().num_threads(t.max(1)).build_global().context("setting up threads")?;
@@ -149,7 +169,39 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 let _ = ctrlc::set_handler(move || c.store(true, Ordering::Relaxed));
             }
             let opts = snee::render::RenderOptions { spp, seed, time_budget: time, progress: !quiet };
-            let out = snee::render::render(&loaded, &opts, &cancel);
+            let reference = match &reference {
+                Some(r) => Some(
+                    snee::compare::rgb_of(&snee::io::read::read_image(r, false)?)
+                        .map_err(|e| anyhow!("{}: {}", r.display(), e))?,
+                ),
+                None => None,
+            };
+            let mut rows: Vec<(f64, u32, f64)> = Vec::new();
+            let mut record = |t: f64, spp: u32, data: &[f32]| {
+                if let Some(r) = &reference {
+                    let n = data.len() / r.len().max(1);
+                    let img: Vec<[f32; 3]> = data.chunks(n.max(3)).map(|p| [p[0], p[1], p[2]]).collect();
+                    if img.len() == r.len() {
+                        rows.push((t, spp, snee::compare::rel_mse(&img, r)));
+                    }
+                }
+            };
+            let out = snee::render::render_with(
+                &loaded,
+                &opts,
+                &cancel,
+                reference.as_ref().map(|_| &mut record as snee::render::PassCallback),
+            );
+            if let (Some(r), Some(path)) = (&reference, &convergence) {
+                if r.len() != out.width * out.height {
+                    return Err(anyhow!("--reference is {} pixels, the render {}x{}", r.len(), out.width, out.height));
+                }
+                let mut csv = String::from("seconds,spp,rel_mse\n");
+                for (t, spp, e) in &rows {
+                    csv += &format!("{t:.6},{spp},{e:.6e}\n");
+                }
+                std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))?;
+            }
             write_output(&output, &out, png)?;
             let st = out.stats.to_json();
             if let Some(p) = stats {

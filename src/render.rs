@@ -80,6 +80,21 @@ fn sample_li(scene: &Scene, sampler: &mut Sampler, ray: crate::math::Ray, stats:
 
 /// Render the scene. `cancel` stops early (Ctrl-C); the samples done so far are kept.
 pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> RenderOutput {
+    render_with(scene, opts, cancel, None)
+}
+
+/// Called after every pass that ends on a power-of-two sample count, with the render time so far
+/// (seconds, not counting the callback), the samples per pixel done, and the developed image
+/// (channels interleaved as in [`RenderOutput`]).
+pub type PassCallback<'a> = &'a mut dyn FnMut(f64, u32, &[f32]);
+
+/// [`render`] with a callback at doubling sample counts (for convergence curves).
+pub fn render_with(
+    scene: &Scene,
+    opts: &RenderOptions,
+    cancel: &AtomicBool,
+    mut on_pass: Option<PassCallback>,
+) -> RenderOutput {
     let film = &scene.film;
     let (cw, ch) = film.crop_size;
     // Samples are taken in the sample window (the crop window, plus the filter border with `sample_border`).
@@ -129,11 +144,13 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
     let mut spp_done = 0u32;
     let mut pass = 0u64;
     let mut samples_done = 0u64;
+    // Time spent in `on_pass`, excluded from the reported render time.
+    let mut callback_seconds = 0.0f64;
     while spp_done < total_spp && !cancel.load(Ordering::Relaxed) {
-        // Passes double in size (1, 2, 4, ... 64 spp); with a time budget, a pass is cut to what
+        // Pass sizes 1, 1, 2, 4, ... 64 spp, so that passes end on every power of two; with a time budget, a pass is cut to what
         // the measured rate says fits in the remaining time, and none starts that would end
         // more than half a sample per pixel past the budget.
-        let mut pass_spp = (1u32 << pass.min(6)).min(total_spp - spp_done);
+        let mut pass_spp = (1u32 << pass.saturating_sub(1).min(6)).min(total_spp - spp_done);
         if let Some(t) = opts.time_budget {
             let elapsed = start.elapsed().as_secs_f64();
             if spp_done > 0 {
@@ -206,12 +223,20 @@ pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> Rende
         }
         spp_done += pass_spp;
         pass += 1;
+        if let Some(cb) = on_pass.as_mut() {
+            if spp_done.is_power_of_two() {
+                let t = start.elapsed().as_secs_f64() - callback_seconds;
+                let t0 = Instant::now();
+                cb(t, spp_done, &full.develop());
+                callback_seconds += t0.elapsed().as_secs_f64();
+            }
+        }
         if total_spp == u32::MAX {
             bar.set_message(format!("{} spp", spp_done));
         }
     }
     bar.finish_and_clear();
-    let seconds = start.elapsed().as_secs_f64();
+    let seconds = start.elapsed().as_secs_f64() - callback_seconds;
     let data = full.develop();
     RenderOutput {
         width: cw as usize,

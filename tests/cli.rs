@@ -147,3 +147,22 @@ fn compare_reports_metrics_and_z_test() {
     assert!(v["rel_mse"].as_f64().unwrap() > 0.0);
     assert!(v["z_test"]["tests"].as_u64().unwrap() == 96 * 96 * 3);
 }
+
+#[test]
+fn convergence_csv_at_doubling_sample_counts() {
+    let dir = out_dir();
+    let csv = dir.join("conv.csv");
+    let o = snee()
+        .args(["render", "scenes/cornell_box.xml", "-o", dir.join("conv.exr").to_str().unwrap(), "--spp", "16", "-q"])
+        .args(["--reference", "reference/cornell_box.exr", "--convergence", csv.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<f64>> =
+        text.lines().skip(1).map(|l| l.split(',').map(|v| v.parse::<f64>().unwrap()).collect()).collect();
+    assert_eq!(rows.iter().map(|r| r[1] as u32).collect::<Vec<_>>(), vec![1, 2, 4, 8, 16]);
+    // An unbiased render's relMSE roughly halves with every doubling of the samples.
+    assert!(rows[4][2] < rows[0][2] / 4.0, "{}", text);
+    assert!(rows.windows(2).all(|w| w[1][0] >= w[0][0]));
+}
