@@ -6,8 +6,10 @@
 //! - per pixel: two-sample Z-test; a pixel's variance is the per-sample variance (ours from the
 //!   second-moment channel, the reference's from `var.*`) times the filter's variance factor
 //!   f = ∫w² / (∫w)² over the samples that reach the pixel (larger near the image border), over N;
-//! - per 8×8 block: Welch-style t-test, our variance from independent batches (exact under the
-//!   pixel filter's correlations), the reference's from its variance channel;
+//! - per 8×8 block: Welch-style t-test, our variance the larger of the batch estimate (exact under
+//!   the pixel filter's correlations, but blind to rare bright samples in 16 batches) and the
+//!   reference's per-sample variance scaled to our sample count (which sees those samples); the
+//!   reference's own variance from its variance channel;
 //! - the whole image (same batch method), which is what catches a ~1 % bias.
 //!
 //! Per-pixel tests are fragile where rare, very bright samples dominate (caustics of the sun
@@ -75,11 +77,13 @@ fn render_batches(scene_path: &Path, spp_per_batch: u32) -> (Vec<Image>, Image, 
     scene.integrator.moment = true;
     let factor = variance_factor(&scene.film.filter, scene.film.crop_size.0 as usize, scene.film.crop_size.1 as usize);
     let cancel = AtomicBool::new(false);
+    // `SNEE_TEST_SEED` re-runs the suite on other random streams (robustness checks).
+    let seed0 = std::env::var("SNEE_TEST_SEED").ok().and_then(|v| v.parse().ok()).unwrap_or(1000u64);
     let mut batches = Vec::new();
     let mut m2_sum: Vec<[f64; 3]> = Vec::new();
     for b in 0..BATCHES {
         let opts =
-            RenderOptions { spp: Some(spp_per_batch), seed: 1000 + b as u64, time_budget: None, progress: false };
+            RenderOptions { spp: Some(spp_per_batch), seed: seed0 + b as u64, time_budget: None, progress: false };
         let out = render(&scene, &opts, &cancel);
         let n = out.channels.len();
         let m2i = out.channels.iter().position(|c| c == "m2.R").expect("moment channels");
@@ -219,8 +223,12 @@ fn compare_scene(name: &str, spp_per_batch: u32, per_pixel: bool, bias: f64) -> 
             let per_batch: Vec<f64> = batches.iter().map(|b| avg(&b.mean)).collect();
             let m = per_batch.iter().sum::<f64>() / BATCHES as f64;
             let s2 = per_batch.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (BATCHES - 1) as f64;
-            let var_ours = s2 / BATCHES as f64;
             let var_ref = px.iter().map(|&i| ref_var[i][c]).sum::<f64>() / (px.len() * px.len()) as f64;
+            // Our variance: the batch estimate captures the filter's pixel correlations but misses
+            // rare bright samples on heavy-tailed scenes; the reference's per-sample variance (from
+            // 8k–16k spp) scaled to our sample count catches those. Take the larger of the two.
+            let spp_ours = (spp_per_batch as usize * BATCHES) as f64;
+            let var_ours = (s2 / BATCHES as f64).max(var_ref * spp_ref / spp_ours);
             let d = m - avg(&ref_mean);
             let var = var_ours + var_ref + (PRECISION * avg(&ref_mean)).powi(2);
             let p = if var > 0.0 {
