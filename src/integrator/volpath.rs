@@ -338,76 +338,33 @@ pub fn li_with(
         // ---- Emitters hit by the ray (area lights, or the environment on escape) ----
         let count_direct = depth == 0 || specular_chain;
         let hide = depth == 0 && desc.hide_emitters;
-        if !hide {
-            match &si {
-                Some(s) if scene.shapes[s.shape as usize].emitter.is_some() => {
-                    let le = scene.eval_area_emitter(s);
-                    if le != Spectrum::ZERO {
-                        let w = if count_direct {
-                            1.0
-                        } else {
-                            let ds = scene.direction_sample_for_hit(last_scatter_p, s);
-                            mis_weight(last_scatter_pdf, scene.pdf_emitter_direction(last_scatter_p, &ds))
-                        };
-                        let light = || {
-                            let ds = scene.direction_sample_for_hit(last_scatter_p, s);
-                            LightSample {
-                                omega_l: ray.d,
-                                p: s.p,
-                                dist: ds.dist,
-                                p_light: scene.pdf_emitter_direction(last_scatter_p, &ds),
-                                delta: false,
-                                le: Spectrum::ZERO,
-                            }
-                        };
-                        let w = suffix_weight(
-                            scene,
-                            snee,
-                            pending.as_ref(),
-                            light,
-                            ForwardTechnique::Bsdf,
-                            w,
-                            channel,
-                            stats,
-                        );
-                        result += beta * le * w;
-                    }
-                }
-                None => {
-                    if let Some(env) = scene.environment {
-                        let le = scene.eval_environment(ray.d);
-                        let w = if count_direct {
-                            1.0
-                        } else {
-                            let ds = scene.environment_direction_sample(env, ray.d);
-                            mis_weight(last_scatter_pdf, scene.pdf_emitter_direction(last_scatter_p, &ds))
-                        };
-                        let light = || {
-                            let ds = scene.environment_direction_sample(env, ray.d);
-                            LightSample {
-                                omega_l: ray.d,
-                                p: last_scatter_p,
-                                dist: f32::INFINITY,
-                                p_light: scene.pdf_emitter_direction(last_scatter_p, &ds),
-                                delta: false,
-                                le: Spectrum::ZERO,
-                            }
-                        };
-                        let w = suffix_weight(
-                            scene,
-                            snee,
-                            pending.as_ref(),
-                            light,
-                            ForwardTechnique::Bsdf,
-                            w,
-                            channel,
-                            stats,
-                        );
-                        result += beta * le * w;
-                    }
-                }
-                _ => {}
+        // The emitter hit, as (radiance, direction sample from the last scattering vertex, the point
+        // used for SNEE's light record). An area light with zero radiance toward us is no hit.
+        let hit = match &si {
+            Some(s) if scene.shapes[s.shape as usize].emitter.is_some() => {
+                let le = scene.eval_area_emitter(s);
+                (le != Spectrum::ZERO).then(|| (le, scene.direction_sample_for_hit(last_scatter_p, s), s.p))
             }
+            None => scene.environment.map(|env| {
+                (scene.eval_environment(ray.d), scene.environment_direction_sample(env, ray.d), last_scatter_p)
+            }),
+            _ => None,
+        };
+        if let (false, Some((le, ds, light_p))) = (hide, hit) {
+            // The emitter-sampling density of this direction, computed at most once.
+            let p_light = std::cell::OnceCell::new();
+            let p_light = || *p_light.get_or_init(|| scene.pdf_emitter_direction(last_scatter_p, &ds));
+            let w = if count_direct { 1.0 } else { mis_weight(last_scatter_pdf, p_light()) };
+            let light = || LightSample {
+                omega_l: ray.d,
+                p: light_p,
+                dist: ds.dist,
+                p_light: p_light(),
+                delta: false,
+                le: Spectrum::ZERO,
+            };
+            let w = suffix_weight(scene, snee, pending.as_ref(), light, ForwardTechnique::Bsdf, w, channel, stats);
+            result += beta * le * w;
         }
         let Some(s) = si else { break };
         let bsdf = scene.bsdf(&s);
