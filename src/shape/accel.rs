@@ -8,10 +8,12 @@
 
 use super::{Geometry, Shape};
 use crate::math::{Ray, Vec3};
+use glam::UVec2;
 use glam::{Vec3A, Vec3Swizzles, Vec4};
 use obvhs::aabb::Aabb as BvhAabb;
+use obvhs::cwbvh::node::{extract_byte64, CwBvhNode};
 use obvhs::cwbvh::CwBvh;
-use obvhs::ray::{Ray as BvhRay, RayHit};
+use obvhs::ray::Ray as BvhRay;
 use obvhs::{Boundable, BvhBuildParams};
 use std::time::Duration;
 
@@ -123,51 +125,147 @@ impl Accel {
 
     /// Closest hit along the ray in (0, ray.tmax).
     pub fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
-        let bvh = self.bvh.as_ref()?;
-        let ray = &positive_zeros(ray);
-        let wt = WatertightRay::new(ray);
-        let bray = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, ray.tmax);
-        let mut hit = RayHit::none();
-        let (mut b1, mut b2) = (0.0, 0.0);
-        let found = bvh.ray_traverse(bray, &mut hit, |r, id| {
-            let tri = &self.tris[id];
-            if tri.is_analytic() {
-                let t = intersect_analytic(&shapes[self.prims[id].shape as usize], ray, r.tmax);
-                if t < r.tmax {
-                    b1 = 0.0;
-                    b2 = 0.0;
-                }
-                t
-            } else if let Some((t, u, v)) = wt.intersect(tri, r.tmax) {
-                b1 = u;
-                b2 = v;
-                t
-            } else {
-                f32::INFINITY
-            }
-        });
-        if !found {
-            return None;
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("sse4.1") {
+            // SAFETY: the CPU supports SSE4.1 (checked just above).
+            return unsafe { self.intersect_sse41(shapes, ray) };
         }
-        let pr = self.prims[hit.primitive_id as usize];
-        Some(Hit { shape: pr.shape, prim: pr.prim, b1, b2, t: hit.t })
+        self.intersect_with(shapes, ray, |node, r, oct| node.intersect_ray(r, oct))
     }
 
     /// True when anything blocks the ray in (0, ray.tmax).
     pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("sse4.1") {
+            // SAFETY: the CPU supports SSE4.1 (checked just above).
+            return unsafe { self.occluded_sse41(shapes, ray) };
+        }
+        self.occluded_with(shapes, ray, |node, r, oct| node.intersect_ray(r, oct))
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "sse4.1")]
+    fn intersect_sse41(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
+        self.intersect_with(shapes, ray, |node, r, oct| intersect_node_sse41(node, r, oct))
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "sse4.1")]
+    fn occluded_sse41(&self, shapes: &[Shape], ray: &Ray) -> bool {
+        self.occluded_with(shapes, ray, |node, r, oct| intersect_node_sse41(node, r, oct))
+    }
+
+    /// Closest-hit traversal (obvhs's `CwBvh::ray_traverse`) with the node test `node_test`.
+    #[inline(always)]
+    fn intersect_with(
+        &self,
+        shapes: &[Shape],
+        ray: &Ray,
+        node_test: impl Fn(&CwBvhNode, &BvhRay, u32) -> u32,
+    ) -> Option<Hit> {
+        let bvh = self.bvh.as_ref()?;
+        let ray = &positive_zeros(ray);
+        let wt = WatertightRay::new(ray);
+        let mut r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, ray.tmax);
+        let (mut b1, mut b2, mut hit_id) = (0.0, 0.0, u32::MAX);
+        let mut state = bvh.new_traversal(r.direction);
+        let mut node;
+        obvhs::traverse!(bvh, node, state, node_test(node, &r, state.oct_inv4), {
+            let id = state.primitive_id as usize;
+            let tri = &self.tris[id];
+            if tri.is_analytic() {
+                let t = intersect_analytic(&shapes[self.prims[id].shape as usize], ray, r.tmax);
+                if t < r.tmax {
+                    (b1, b2, hit_id, r.tmax) = (0.0, 0.0, state.primitive_id, t);
+                }
+            } else if let Some((t, u, v)) = wt.intersect(tri, r.tmax) {
+                (b1, b2, hit_id, r.tmax) = (u, v, state.primitive_id, t);
+            }
+        });
+        let pr = self.prims.get(hit_id as usize)?;
+        Some(Hit { shape: pr.shape, prim: pr.prim, b1, b2, t: r.tmax })
+    }
+
+    /// Any-hit traversal (obvhs's `CwBvh::ray_traverse_miss`) with the node test `node_test`.
+    #[inline(always)]
+    fn occluded_with(&self, shapes: &[Shape], ray: &Ray, node_test: impl Fn(&CwBvhNode, &BvhRay, u32) -> u32) -> bool {
         let Some(bvh) = self.bvh.as_ref() else { return false };
         let ray = &positive_zeros(ray);
         let wt = WatertightRay::new(ray);
-        let bray = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, ray.tmax);
-        !bvh.ray_traverse_miss(bray, |r, id| {
-            let tri = &self.tris[id];
-            if tri.is_analytic() {
-                intersect_analytic(&shapes[self.prims[id].shape as usize], ray, r.tmax)
-            } else {
-                wt.intersect(tri, r.tmax).map_or(f32::INFINITY, |h| h.0)
-            }
-        })
+        let r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, ray.tmax);
+        let mut state = bvh.new_traversal(r.direction);
+        let mut node;
+        let mut blocked = false;
+        'traversal: {
+            obvhs::traverse!(bvh, node, state, node_test(node, &r, state.oct_inv4), {
+                let id = state.primitive_id as usize;
+                let tri = &self.tris[id];
+                blocked = if tri.is_analytic() {
+                    intersect_analytic(&shapes[self.prims[id].shape as usize], ray, r.tmax) < r.tmax
+                } else {
+                    wt.intersect(tri, r.tmax).is_some()
+                };
+                if blocked {
+                    break 'traversal;
+                }
+            });
+        }
+        blocked
     }
+}
+
+/// obvhs's SIMD node test (`CwBvhNode::intersect_ray_simd`, the same floating-point operations and
+/// so the same hit mask), with the quantized child planes widened to floats by SSE4.1: three
+/// instructions per four planes instead of four scalar conversions, the most expensive part of
+/// obvhs's version on a baseline x86-64 build.
+/// obvhs's (crate-private) lower bound of the ray interval in its node test.
+#[cfg(target_arch = "x86_64")]
+const NODE_EPSILON: f32 = 0.0001;
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "sse4.1")]
+#[inline]
+fn intersect_node_sse41(node: &CwBvhNode, ray: &BvhRay, oct_inv4: u32) -> u32 {
+    use std::arch::x86_64::*;
+    #[target_feature(enable = "sse4.1")]
+    #[inline]
+    fn planes(q: &[u8; 8], half: usize) -> __m128 {
+        let bytes = [q[4 * half], q[4 * half + 1], q[4 * half + 2], q[4 * half + 3]];
+        _mm_cvtepi32_ps(_mm_cvtepu8_epi32(_mm_cvtsi32_si128(i32::from_le_bytes(bytes))))
+    }
+    let dir_inv = node.compute_extent() * ray.inv_direction;
+    let orig = (Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
+    let (dx, dy, dz) = (_mm_set1_ps(dir_inv.x), _mm_set1_ps(dir_inv.y), _mm_set1_ps(dir_inv.z));
+    let (ox, oy, oz) = (_mm_set1_ps(orig.x), _mm_set1_ps(orig.y), _mm_set1_ps(orig.z));
+    let (neg_x, neg_y, neg_z) = (ray.direction.x < 0.0, ray.direction.y < 0.0, ray.direction.z < 0.0);
+    let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
+    let mut hit_mask = 0u32;
+    for half in 0..2 {
+        let (lo, hi) = (planes(&node.child_min_x, half), planes(&node.child_max_x, half));
+        let (x_min, x_max) = if neg_x { (hi, lo) } else { (lo, hi) };
+        let tmin_x = _mm_add_ps(_mm_mul_ps(x_min, dx), ox);
+        let tmax_x = _mm_add_ps(_mm_mul_ps(x_max, dx), ox);
+        let (lo, hi) = (planes(&node.child_min_y, half), planes(&node.child_max_y, half));
+        let (y_min, y_max) = if neg_y { (hi, lo) } else { (lo, hi) };
+        let tmin_y = _mm_add_ps(_mm_mul_ps(y_min, dy), oy);
+        let tmax_y = _mm_add_ps(_mm_mul_ps(y_max, dy), oy);
+        let (lo, hi) = (planes(&node.child_min_z, half), planes(&node.child_max_z, half));
+        let (z_min, z_max) = if neg_z { (hi, lo) } else { (lo, hi) };
+        let tmin_z = _mm_add_ps(_mm_mul_ps(z_min, dz), oz);
+        let tmax_z = _mm_add_ps(_mm_mul_ps(z_max, dz), oz);
+        let tmin = _mm_max_ps(tmin_x, _mm_max_ps(tmin_y, tmin_z));
+        let tmax = _mm_min_ps(tmax_x, _mm_min_ps(tmax_y, tmax_z));
+        let tmin = _mm_max_ps(tmin, _mm_set1_ps(NODE_EPSILON));
+        let tmax = _mm_min_ps(tmax, _mm_set1_ps(ray.tmax));
+        let mask = _mm_movemask_ps(_mm_cmple_ps(tmin, tmax));
+        for j in 0..4 {
+            if mask & (1 << j) != 0 {
+                let slot = half * 4 + j;
+                hit_mask |= extract_byte64(child_bits8, slot) << extract_byte64(bit_index8, slot);
+            }
+        }
+    }
+    hit_mask
 }
 
 /// obvhs's traversal misses everything for a direction with a −0.0 component (its octant from
@@ -389,7 +487,6 @@ mod tests {
                         let ray = positive_zeros(ray);
                         let wt = WatertightRay::new(&ray);
                         let mut r = BvhRay::new(ray.o.into(), ray.d.into(), 0.0, ray.tmax);
-                        use glam::UVec2;
                         let mut state = bvh.new_traversal(r.direction);
                         let mut node;
                         obvhs::traverse!(
@@ -425,6 +522,51 @@ mod tests {
                     found.1,
                     accel.bvh.as_ref().map_or(0, |b| b.nodes.len())
                 );
+            }
+        }
+    }
+
+    /// The SSE4.1 node test gives obvhs's hit masks exactly, on every node of a triangle-soup BVH.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn sse41_node_test_equals_obvhs() {
+        if !std::arch::is_x86_feature_detected!("sse4.1") {
+            return;
+        }
+        let mut s = Sampler::new(11, 0);
+        let mut data = crate::shape::mesh_data::MeshData::default();
+        for i in 0..3000u32 {
+            let c = Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) * 10.0;
+            for _ in 0..3 {
+                data.positions.push(c + Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) * 0.5);
+            }
+            data.indices.push([3 * i, 3 * i + 1, 3 * i + 2]);
+        }
+        let mesh = crate::shape::Mesh::new(data, &crate::math::Mat4::IDENTITY, true, false);
+        let shapes = [Shape {
+            geometry: Geometry::Mesh(mesh),
+            plugin: "ply".into(),
+            id: None,
+            bsdf: 0,
+            emitter: None,
+            interior: None,
+            exterior: None,
+        }];
+        let accel = Accel::build(&shapes);
+        let bvh = accel.bvh.as_ref().unwrap();
+        assert!(bvh.nodes.len() > 50);
+        for i in 0..300 {
+            let o = Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) * 14.0 - 2.0;
+            let mut d = crate::math::warp::square_to_uniform_sphere(s.next_2d());
+            if i % 5 == 0 {
+                d = Vec3::new(d.x, 0.0, d.z).normalize();
+            }
+            let r = BvhRay::new(o.into(), d.into(), 0.0, 1.0 + 20.0 * s.next_1d());
+            let oct = bvh.new_traversal(r.direction).oct_inv4;
+            for node in &bvh.nodes {
+                // SAFETY: SSE4.1 support checked above.
+                let got = unsafe { intersect_node_sse41(node, &r, oct) };
+                assert_eq!(got, node.intersect_ray(&r, oct));
             }
         }
     }
