@@ -14,8 +14,8 @@
 use super::rfilter::{FilterKernel, RFilter};
 use glam::Vec2;
 
-/// Largest filter footprint (pixels per axis) whose x weights are cached on the stack.
-const MAX_CACHED_TAPS: usize = 32;
+/// Largest filter footprint (pixels per axis) whose weights are computed once per sample on the stack.
+const MAX_CACHED_TAPS: usize = 16;
 
 #[derive(Clone, Debug)]
 pub struct ImageBlock {
@@ -128,14 +128,52 @@ impl ImageBlock {
             return;
         }
         let count_x = (x1 - x0 + 1) as usize;
+        let count_y = (y1 - y0 + 1) as usize;
         let kernel = self.kernel;
+        if count_x > MAX_CACHED_TAPS || count_y > MAX_CACHED_TAPS {
+            self.put_uncached(pos, values, (x0, x1), (y0, y1));
+            return;
+        }
         let mut weights_x = [0.0f32; MAX_CACHED_TAPS];
-        let cached = count_x <= MAX_CACHED_TAPS;
-        if cached {
-            for (i, wx) in weights_x.iter_mut().take(count_x).enumerate() {
-                *wx = kernel.eval((x0 + i as i64) as f32 + 0.5 - pos.x);
+        let mut weights_y = [0.0f32; MAX_CACHED_TAPS];
+        kernel.eval_taps(x0, pos.x, &mut weights_x[..count_x]);
+        kernel.eval_taps(y0, pos.y, &mut weights_y[..count_y]);
+        let weights_x = &weights_x[..count_x];
+        let weights_y = &weights_y[..count_y];
+        let first = ((y0 - oy) as usize * w + (x0 - ox) as usize) * stride;
+        let row_stride = w * stride;
+        // Fixed channel counts let the compiler unroll the per-pixel loop (RGB + alpha, with moments).
+        match self.channels {
+            3 => accumulate::<3>(&mut self.data[first..], row_stride, values, weights_x, weights_y),
+            4 => accumulate::<4>(&mut self.data[first..], row_stride, values, weights_x, weights_y),
+            7 => accumulate::<7>(&mut self.data[first..], row_stride, values, weights_x, weights_y),
+            _ => {
+                for (j, &wy) in weights_y.iter().enumerate() {
+                    if wy == 0.0 {
+                        continue;
+                    }
+                    let start = first + j * row_stride;
+                    let row = &mut self.data[start..start + count_x * stride];
+                    for (px, &wx) in row.chunks_exact_mut(stride).zip(weights_x) {
+                        let weight = wx * wy;
+                        let (px_values, px_weight) = px.split_at_mut(self.channels);
+                        for (d, v) in px_values.iter_mut().zip(values) {
+                            *d += v * weight;
+                        }
+                        px_weight[0] += weight;
+                    }
+                }
             }
         }
+    }
+
+    /// `put` for footprints wider than [`MAX_CACHED_TAPS`]: weights evaluated per pixel.
+    fn put_uncached(&mut self, pos: Vec2, values: &[f32], (x0, x1): (i64, i64), (y0, y1): (i64, i64)) {
+        let (ox, oy) = self.storage_origin();
+        let (w, _) = self.storage_size();
+        let stride = self.channels + 1;
+        let count_x = (x1 - x0 + 1) as usize;
+        let kernel = self.kernel;
         for y in y0..=y1 {
             let wy = kernel.eval(y as f32 + 0.5 - pos.y);
             if wy == 0.0 {
@@ -144,8 +182,7 @@ impl ImageBlock {
             let start = ((y - oy) as usize * w + (x0 - ox) as usize) * stride;
             let row = &mut self.data[start..start + count_x * stride];
             for (i, px) in row.chunks_exact_mut(stride).enumerate() {
-                let wx = if cached { weights_x[i] } else { kernel.eval((x0 + i as i64) as f32 + 0.5 - pos.x) };
-                let weight = wx * wy;
+                let weight = kernel.eval((x0 + i as i64) as f32 + 0.5 - pos.x) * wy;
                 let (px_values, px_weight) = px.split_at_mut(self.channels);
                 for (d, v) in px_values.iter_mut().zip(values) {
                     *d += v * weight;
@@ -210,6 +247,27 @@ impl ImageBlock {
     }
 }
 
+/// Add `w(x)·w(y)·values` and the weight `w(x)·w(y)` to the pixels of a footprint starting at
+/// `data[0]` (rows `row_stride` apart, `N` values then the weight per pixel).
+#[inline(always)]
+fn accumulate<const N: usize>(data: &mut [f32], row_stride: usize, values: &[f32], wxs: &[f32], wys: &[f32]) {
+    let Ok(values) = <&[f32; N]>::try_from(values) else { return };
+    for (j, &wy) in wys.iter().enumerate() {
+        if wy == 0.0 {
+            continue;
+        }
+        let start = j * row_stride;
+        let row = &mut data[start..start + wxs.len() * (N + 1)];
+        for (px, &wx) in row.chunks_exact_mut(N + 1).zip(wxs) {
+            let weight = wx * wy;
+            for c in 0..N {
+                px[c] += values[c] * weight;
+            }
+            px[N] += weight;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -234,5 +292,43 @@ mod tests {
         // Centres 3.5 .. 6.5 are within 2 of 5.0 → 4 pixels per axis, weight 0 exactly at ±2 not reached.
         let touched = (0..10).flat_map(|y| (0..10).map(move |x| (x, y))).filter(|&(x, y)| b.weight(x, y) > 0.0).count();
         assert_eq!(touched, 16);
+    }
+
+    /// The splatted sums equal a per-pixel evaluation of the filter, bit for bit, for the
+    /// unrolled channel counts and the generic one.
+    #[test]
+    fn put_equals_per_pixel_filter() {
+        let mut rng = crate::sampler::Sampler::new(5, 0);
+        for filter in [RFilter::default(), RFilter::Gaussian { stddev: 0.4 }, RFilter::Tent { radius: 1.5 }] {
+            for channels in [3, 4, 5, 7] {
+                let (offset, size) = ((3, -2), (9u32, 7u32));
+                let mut block = ImageBlock::new(offset, size, filter, channels);
+                let border = block.border() as i64;
+                let (w, h) = (size.0 as i64 + 2 * border, size.1 as i64 + 2 * border);
+                let mut want = vec![0.0f32; (w * h) as usize * (channels + 1)];
+                for _ in 0..200 {
+                    let pos = Vec2::new(rng.next_1d() * 13.0, rng.next_1d() * 11.0 - 4.0);
+                    let values: Vec<f32> = (0..channels).map(|_| rng.next_1d() * 4.0).collect();
+                    block.put(pos, &values);
+                    for y in 0..h {
+                        for x in 0..w {
+                            let (fx, fy) = (x + offset.0 as i64 - border, y + offset.1 as i64 - border);
+                            let (dx, dy) = (fx as f32 + 0.5 - pos.x, fy as f32 + 0.5 - pos.y);
+                            let r = filter.radius();
+                            if dx.abs() > r || dy.abs() > r || filter.eval(dy) == 0.0 {
+                                continue;
+                            }
+                            let weight = filter.eval(dx) * filter.eval(dy);
+                            let base = ((y * w + x) as usize) * (channels + 1);
+                            for c in 0..channels {
+                                want[base + c] += values[c] * weight;
+                            }
+                            want[base + channels] += weight;
+                        }
+                    }
+                }
+                assert_eq!(block.data, want, "{filter:?}, {channels} channels");
+            }
+        }
     }
 }

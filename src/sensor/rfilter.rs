@@ -165,8 +165,34 @@ impl FilterKernel {
                     0.0
                 }
             }
-            FilterKernel::Gaussian { coeff, .. } => estrin10(x * x, coeff).max(0.0),
+            FilterKernel::Gaussian { coeff, .. } => gaussian(x, coeff),
             FilterKernel::Tent { inv_radius, .. } => (1.0 - (x * inv_radius).abs()).max(0.0),
+        }
+    }
+}
+
+impl FilterKernel {
+    /// `out[i] = eval((first + i) as f32 + 0.5 - pos)`: the weights of consecutive pixels, whose
+    /// centres are at `first + i + 0.5`, for a sample at `pos` (exactly as `eval` per pixel).
+    #[inline]
+    pub fn eval_taps(&self, first: i64, pos: f32, out: &mut [f32]) {
+        match self {
+            FilterKernel::Gaussian { coeff, .. } => {
+                #[cfg(target_arch = "x86_64")]
+                if std::arch::is_x86_feature_detected!("fma") {
+                    // SAFETY: the CPU supports FMA (checked just above).
+                    unsafe { gaussian_taps_fma(first, pos, coeff, out) };
+                    return;
+                }
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = estrin10((first + i as i64) as f32 + 0.5 - pos, coeff, fmadd).max(0.0);
+                }
+            }
+            _ => {
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = self.eval((first + i as i64) as f32 + 0.5 - pos);
+                }
+            }
         }
     }
 }
@@ -182,33 +208,67 @@ fn gaussian_coeffs(stddev: f32) -> [f32; 10] {
         scale *= inv_var;
     }
     let radius = 4.0 * stddev;
-    coeff[0] -= estrin10(radius * radius, &coeff);
+    // Once per filter: the correctly rounded (if slow) fused multiply-add, as Mitsuba's scalar code.
+    coeff[0] -= estrin10(radius, &coeff, f32::mul_add);
     coeff
 }
 
-/// `a·b + c` rounded once, like Dr.Jit's `fmadd` (the f64 product of two f32 is exact). Near the
-/// radius the Gaussian polynomial cancels heavily and separate rounding changes `eval(1.9)` by 1.5%.
+/// The Gaussian at offset `x`: the polynomial in `x²`, clamped at 0. With hardware FMA (checked at
+/// run time; std caches the answer) the fused multiply-adds are the CPU's, as in Mitsuba.
+#[inline]
+fn gaussian(x: f32, coeff: &[f32; 10]) -> f32 {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU supports FMA (checked just above).
+        return unsafe { estrin10_fma(x, coeff) }.max(0.0);
+    }
+    estrin10(x, coeff, fmadd).max(0.0)
+}
+
+/// `gaussian` at `(first + i) + 0.5 - pos` for each `out[i]`, with hardware fused multiply-adds
+/// (the compiler vectorizes across taps).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+fn gaussian_taps_fma(first: i64, pos: f32, coeff: &[f32; 10], out: &mut [f32]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = estrin10_fma((first + i as i64) as f32 + 0.5 - pos, coeff).max(0.0);
+    }
+}
+
+/// [`estrin10`] with the CPU's fused multiply-add (one rounding, exactly Dr.Jit's `fmadd`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+#[inline]
+fn estrin10_fma(x: f32, coeff: &[f32; 10]) -> f32 {
+    estrin10(x, coeff, f32::mul_add)
+}
+
+/// `a·b + c` rounded to f64 and then to f32: Dr.Jit's `fmadd` up to a double rounding in rare ties
+/// (the f64 product of two f32 is exact), for CPUs without FMA (where `f32::mul_add` is a slow
+/// library call). Near the radius the Gaussian polynomial cancels heavily, and rounding the
+/// product separately would change `eval(1.9)` by 1.5%.
 #[inline]
 fn fmadd(a: f32, b: f32, c: f32) -> f32 {
     (a as f64 * b as f64 + c as f64) as f32
 }
 
-/// Estrin's scheme for a degree-9 polynomial, in the order and with the fused multiply-adds of
-/// Dr.Jit's `estrin_impl`.
-#[inline]
-fn estrin10(x: f32, c: &[f32; 10]) -> f32 {
+/// Estrin's scheme for the degree-9 polynomial in `x²`, in the order of Dr.Jit's `estrin_impl`,
+/// with `fma(a, b, c) = a·b + c`.
+#[inline(always)]
+fn estrin10(x: f32, c: &[f32; 10], fma: impl Fn(f32, f32, f32) -> f32) -> f32 {
+    let x = x * x;
     let x2 = x * x;
     let x4 = x2 * x2;
     let x8 = x4 * x4;
-    let a0 = fmadd(x, c[1], c[0]);
-    let a1 = fmadd(x, c[3], c[2]);
-    let a2 = fmadd(x, c[5], c[4]);
-    let a3 = fmadd(x, c[7], c[6]);
-    let a4 = fmadd(x, c[9], c[8]);
-    let b0 = fmadd(x2, a1, a0);
-    let b1 = fmadd(x2, a3, a2);
-    let c0 = fmadd(x4, b1, b0);
-    fmadd(x8, a4, c0)
+    let a0 = fma(x, c[1], c[0]);
+    let a1 = fma(x, c[3], c[2]);
+    let a2 = fma(x, c[5], c[4]);
+    let a3 = fma(x, c[7], c[6]);
+    let a4 = fma(x, c[9], c[8]);
+    let b0 = fma(x2, a1, a0);
+    let b1 = fma(x2, a3, a2);
+    let c0 = fma(x4, b1, b0);
+    fma(x8, a4, c0)
 }
 
 #[cfg(test)]
@@ -239,5 +299,28 @@ mod tests {
         assert_eq!(t.eval(1.6), 0.0);
         assert_eq!(t.border_size(), 1);
         assert!(RFilter::Tent { radius: 0.5 }.is_box_filter());
+    }
+
+    /// Bit patterns of Mitsuba 3.9's `gaussian` (stddev 0.5) `eval`, from Python `scalar_rgb`;
+    /// both our evaluation paths (hardware FMA where available, f64 emulation) must give them.
+    #[test]
+    fn gaussian_bits_match_mitsuba() {
+        let want: [(f32, u32); 7] = [
+            (0.0, 1065340585),
+            (0.3, 1062585778),
+            (0.77, 1050424133),
+            (1.2, 1030002534),
+            (1.5, 1009795892),
+            (1.9, 969628831),
+            (1.99, 939095241),
+        ];
+        let FilterKernel::Gaussian { coeff, .. } = FilterKernel::exact(&RFilter::default()) else { unreachable!() };
+        for (x, bits) in want {
+            assert_eq!(RFilter::default().eval(x).to_bits(), bits, "eval({x})");
+            assert_eq!(estrin10(x, &coeff, fmadd).max(0.0).to_bits(), bits, "f64 path at {x}");
+            let mut out = [0.0];
+            FilterKernel::exact(&RFilter::default()).eval_taps(0, 0.5 - x, &mut out);
+            assert_eq!(out[0].to_bits(), bits, "eval_taps at {x}");
+        }
     }
 }

@@ -75,31 +75,41 @@ impl Mesh {
         b
     }
 
-    /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
-    pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
-        let idx = self.indices[prim as usize];
+    /// Position, geometric normal (flipped with `flip_normals`) and uv of the point at
+    /// barycentrics (b1, b2) of triangle `prim`.
+    #[inline(always)]
+    fn point(&self, idx: [u32; 3], b1: f32, b2: f32) -> (Vec3, Vec3, Vec2) {
         let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
         let b0 = 1.0 - b1 - b2;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
         let uv = if self.uvs.is_empty() {
             Vec2::new(b1, b2)
         } else {
             let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
             u0 * b0 + u1 * b1 + u2 * b2
         };
+        (p, if self.flip_normals { -n } else { n }, uv)
+    }
+
+    /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
+    pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
+        let idx = self.indices[prim as usize];
+        let (p, n, uv) = self.point(idx, b1, b2);
         let mut sh_n = if self.normals.is_empty() {
             n
         } else {
+            let b0 = 1.0 - b1 - b2;
             let [n0, n1, n2] = idx.map(|i| self.normals[i as usize]);
-            (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero()
+            let sh_n = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
+            if self.flip_normals {
+                -sh_n
+            } else {
+                sh_n
+            }
         };
         if sh_n == Vec3::ZERO {
             sh_n = n;
-        }
-        if self.flip_normals {
-            n = -n;
-            sh_n = -sh_n;
         }
         let sh_frame = Frame::from_normal(sh_n);
         SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray_d), shape: 0, prim }
@@ -114,8 +124,8 @@ impl Mesh {
         let area = self.area_cdf[prim] - lo;
         let sx = if area > 0.0 { ((target - lo) / area).clamp(0.0, 1.0 - f32::EPSILON) } else { 0.5 };
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
-        let si = self.interaction(prim as u32, b.x, b.y, 0.0, Vec3::Z);
-        PositionSample { p: si.p, n: si.n, uv: si.uv, pdf: 1.0 / total }
+        let (p, n, uv) = self.point(self.indices[prim], b.x, b.y);
+        PositionSample { p, n, uv, pdf: 1.0 / total }
     }
 }
 
