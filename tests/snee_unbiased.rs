@@ -63,3 +63,33 @@ fn snee_transport_modes_agree() {
     assert!(r1.is_empty(), "snee vs forward:\n{}", r1);
     assert!(r2.is_empty(), "mis vs snee:\n{}", r2);
 }
+
+/// `snee_rate` = 0: SNEE never runs and no suffix is tracked, so the image is volpath's, bit for bit.
+#[test]
+fn rate_zero_is_volpath() {
+    let vp = render_batches(&scene(&xml("volpath", ""), &[]), 2, 4, 8, 6000);
+    let sn = render_batches(&scene(&xml("volpath_snee", r#"<float name="snee_rate" value="0"/>"#), &[]), 2, 4, 8, 6000);
+    assert_eq!(vp.stats, sn.stats);
+    assert_eq!(vp.rays, sn.rays);
+}
+
+/// Any rate is unbiased: SNEE's density in MIS is `r · pdf_snee` (docs/snee.md §5).
+#[test]
+fn partial_rate_agrees_with_full_rate() {
+    let full =
+        render_batches(&scene(&xml("volpath_snee", r#"<float name="snee_rate" value="1"/>"#), &[]), 12, 12, 8, 7000);
+    let part =
+        render_batches(&scene(&xml("volpath_snee", r#"<float name="snee_rate" value="0.3"/>"#), &[]), 12, 12, 8, 8000);
+    let (report, m_full, m_part) = welch_compare(&full, &part, 0.01);
+    eprintln!("rate 1 {:?}\nrate 0.3 {:?}", m_full, m_part);
+    assert!(report.is_empty(), "snee_rate 1 vs 0.3:\n{}", report);
+}
+
+#[test]
+fn rate_out_of_range_is_an_error() {
+    let text = xml("volpath_snee", r#"<float name="snee_rate" value="1.5"/>"#);
+    let parsed = snee::scene::xml::parse_str(&text, "rate.xml", &snee_common::root().join("scenes"), &[]).unwrap();
+    let err = snee::scene::build::build_scene(&parsed).err().expect("snee_rate 1.5 must be rejected");
+    let s = err.to_string();
+    assert!(s.starts_with("rate.xml:2:") && s.contains("snee_rate must be in [0, 1]"), "{}", s);
+}

@@ -97,6 +97,12 @@ impl IntegratorDesc {
                         .error("snee", format!("volpath_snee: snee = \"{}\" is not one of mis, snee, forward", other)))
                 }
             };
+            snee.rate = props.float_opt("snee_rate")?;
+            if let Some(r) = snee.rate {
+                if !(0.0..=1.0).contains(&r) {
+                    return Err(props.error("snee_rate", "volpath_snee: snee_rate must be in [0, 1]"));
+                }
+            }
             snee.transport = match props.string("transport", "all")?.as_str() {
                 "all" => SneeTransport::All,
                 "snee" => SneeTransport::Snee,

@@ -299,7 +299,7 @@ pub fn li_with(
                 // ---- Subdivision next-event estimation (volpath_snee) ----
                 if let Some(opts) = snee {
                     snee_chain = snee_x_i.take().map(|x_i| (x_i, p));
-                    snee_x_i = snee::snee_vertex(scene, mi, p, wi, depth, max_depth);
+                    snee_x_i = snee::snee_vertex(scene, opts, mi, p, wi, depth, max_depth);
                     if let (Some(x_i), true) = (&snee_x_i, opts.technique != SneeTechnique::Forward) {
                         result += snee::sample(scene, x_i, beta, channel, opts.technique, sampler, stats);
                     }

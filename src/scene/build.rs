@@ -155,7 +155,7 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         }
     }
     let accel = Accel::build(&b.shapes);
-    Ok(Scene {
+    let mut scene = Scene {
         accel,
         shapes: b.shapes,
         bsdfs: b.bsdfs,
@@ -168,7 +168,10 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         sensor_medium,
         integrator,
         bounds,
-    })
+        snee_rates: Vec::new(),
+    };
+    scene.snee_rates = crate::integrator::snee::medium_rates(&scene);
+    Ok(scene)
 }
 
 impl Builder<'_> {

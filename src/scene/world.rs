@@ -42,6 +42,9 @@ pub struct Scene {
     pub sensor_medium: Option<u32>,
     pub integrator: IntegratorDesc,
     pub bounds: Aabb,
+    /// Per medium: `None` where SNEE does not apply, else the probability `r` that
+    /// `volpath_snee` runs SNEE at one of its scattering vertices (`integrator::snee::medium_rates`).
+    pub snee_rates: Vec<Option<f32>>,
 }
 
 impl Scene {
