@@ -300,29 +300,36 @@ struct WatertightRay {
     shear_z: [Vec3A; 3],
 }
 
+/// Woop et al. 2013's axis permutation and shear of a ray direction `d`: `kz` is the dominant
+/// axis, `kx, ky` follow it (swapped when `d[kz] < 0`, keeping the winding), and
+/// `(sx, sy, sz) = (d[kx]/d[kz], d[ky]/d[kz], 1/d[kz])`.
+#[inline(always)]
+fn shear_axes(d: Vec3) -> ([usize; 3], [f32; 3]) {
+    let a = d.abs();
+    let kz = if a.x > a.y {
+        if a.x > a.z {
+            0
+        } else {
+            2
+        }
+    } else if a.y > a.z {
+        1
+    } else {
+        2
+    };
+    let mut kx = (kz + 1) % 3;
+    let mut ky = (kx + 1) % 3;
+    if d[kz] < 0.0 {
+        std::mem::swap(&mut kx, &mut ky);
+    }
+    let sz = 1.0 / d[kz];
+    ([kx, ky, kz], [d[kx] * sz, d[ky] * sz, sz])
+}
+
 impl WatertightRay {
     #[inline]
     fn new(ray: &Ray) -> Self {
-        let d = ray.d;
-        let a = d.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z {
-                0
-            } else {
-                2
-            }
-        } else if a.y > a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let sz = 1.0 / d[kz];
-        let (sx, sy) = (d[kx] * sz, d[ky] * sz);
+        let ([kx, ky, kz], [sx, sy, sz]) = shear_axes(ray.d);
         let mut rx = [0.0f32; 3];
         let mut ry = [0.0f32; 3];
         let mut rz = [0.0f32; 3];
@@ -384,26 +391,7 @@ mod tests {
 
     /// The paper's scalar formulation (the previous implementation), as the reference.
     fn woop_scalar(ray: &Ray, v: [Vec3; 3], tmax: f32) -> Option<(f32, f32, f32)> {
-        let d = ray.d;
-        let a = d.abs();
-        let kz = if a.x > a.y {
-            if a.x > a.z {
-                0
-            } else {
-                2
-            }
-        } else if a.y > a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let sz = 1.0 / d[kz];
-        let (sx, sy) = (d[kx] * sz, d[ky] * sz);
+        let ([kx, ky, kz], [sx, sy, sz]) = shear_axes(ray.d);
         let (a, b, c) = (v[0] - ray.o, v[1] - ray.o, v[2] - ray.o);
         let (ax, ay) = (a[kx] - sx * a[kz], a[ky] - sy * a[kz]);
         let (bx, by) = (b[kx] - sx * b[kz], b[ky] - sy * b[kz]);
