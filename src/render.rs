@@ -6,7 +6,6 @@
 
 use crate::color::Spectrum;
 use crate::integrator::stats::{LocalStats, Stats};
-use crate::integrator::{path, snee, volpath, volpathmis, IntegratorKind};
 use crate::math::Vec2;
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
@@ -70,12 +69,7 @@ impl RenderStats {
 /// Radiance for one camera ray, dispatching on the integrator.
 #[inline]
 fn sample_li(scene: &Scene, sampler: &mut Sampler, ray: crate::math::Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
-    match scene.integrator.kind {
-        IntegratorKind::Path => path::li(scene, sampler, ray, stats),
-        IntegratorKind::Volpath => volpath::li(scene, sampler, ray, scene.sensor_medium, stats),
-        IntegratorKind::Volpathmis => volpathmis::li(scene, sampler, ray, scene.sensor_medium, stats),
-        IntegratorKind::VolpathSnee => snee::li(scene, sampler, ray, scene.sensor_medium, stats),
-    }
+    scene.integrator.li(scene, sampler, ray, stats)
 }
 
 /// Render the scene. `cancel` stops early (Ctrl-C); the samples done so far are kept.

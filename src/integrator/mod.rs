@@ -1,128 +1,111 @@
-//! Integrators: `path` (surfaces only), `volpath`, `volpath_snee` (volpath with subdivision NEE), and the
-//! `moment` wrapper that also outputs the per-pixel second moment.
+//! Integrators, one file per XML type: `path` (surfaces only), `volpath`, `volpathmis`,
+//! `volpath_snee` (volpath with subdivision NEE, the technique in `snee/`), and the `moment`
+//! wrapper that also outputs the per-pixel second moment.
+//!
+//! - [`parse`] reads the `<integrator>` element into an [`IntegratorDesc`]; [`build`] turns it into
+//!   the [`Integrator`] the scene keeps, with the tables it precomputes; [`Integrator::li`] is the
+//!   one call the renderer makes per camera ray.
+//! - `walk.rs` holds the walks through media and passable surfaces that every volumetric
+//!   integrator shares; `technique.rs` documents how a connection technique plugs into the
+//!   volpath loop.
+//!
+//! Common parameters (Mitsuba's `MonteCarloIntegrator`):
+//!
+//! | Parameter       | Type    | Default | Description                                            |
+//! |-----------------|---------|---------|--------------------------------------------------------|
+//! | `max_depth`     | integer | -1      | longest path (-1: unbounded, 0: black, 1: emitters seen directly) |
+//! | `rr_depth`      | integer | 5       | depth from which Russian roulette runs                 |
+//! | `hide_emitters` | boolean | false   | emitters seen directly are black                       |
 
+pub mod desc;
+pub mod moment;
 pub mod path;
 pub mod snee;
 pub mod stats;
+pub mod technique;
 pub mod volpath;
+pub mod volpath_snee;
 pub mod volpathmis;
+pub mod walk;
 
-use crate::scene::desc::{ObjectDesc, PluginKind};
+pub use desc::{Integrator, IntegratorDesc, IntegratorKind};
+
+use crate::color::Spectrum;
+use crate::math::Ray;
+use crate::sampler::Sampler;
+use crate::scene::desc::ObjectDesc;
+use crate::scene::world::Scene;
 use crate::scene::{Error, Result};
-use snee::{SneeOptions, SneeTechnique, SneeTransport};
+use stats::LocalStats;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum IntegratorKind {
-    Path,
-    Volpath,
-    Volpathmis,
-    VolpathSnee,
+/// The settings of an `<integrator>` element (its common parameters, and its own).
+pub fn parse(obj: &ObjectDesc) -> Result<IntegratorDesc> {
+    let props = &obj.props;
+    let kind = match obj.plugin.as_str() {
+        "moment" => return moment::parse(obj),
+        "path" => IntegratorKind::Path,
+        "volpath" => IntegratorKind::Volpath,
+        "volpathmis" => IntegratorKind::Volpathmis,
+        "volpath_snee" => IntegratorKind::VolpathSnee,
+        other => {
+            return Err(Error::at(
+                &obj.pos,
+                format!(
+                    "integrator \"{}\" is not supported (supported: path, volpath, volpathmis, volpath_snee, moment)",
+                    other
+                ),
+            ))
+        }
+    };
+    let max_depth = props.int("max_depth", -1)?;
+    if max_depth < -1 {
+        return Err(props.error("max_depth", "max_depth must be -1 (unbounded) or non-negative"));
+    }
+    let rr_depth = props.int("rr_depth", 5)?;
+    if rr_depth <= 0 {
+        return Err(props.error("rr_depth", "rr_depth must be positive"));
+    }
+    let hide_emitters = props.bool("hide_emitters", false)?;
+    let snee = match kind {
+        IntegratorKind::VolpathSnee => volpath_snee::parse_options(props)?,
+        _ => Default::default(),
+    };
+    props.finish()?;
+    let clamp = |v: i64| v.clamp(-1, i32::MAX as i64) as i32;
+    Ok(IntegratorDesc {
+        kind,
+        max_depth: clamp(max_depth),
+        rr_depth: clamp(rr_depth),
+        hide_emitters,
+        moment: false,
+        snee,
+    })
 }
 
-/// Integrator settings (Mitsuba's `MonteCarloIntegrator` parameters).
-#[derive(Clone, Debug)]
-pub struct IntegratorDesc {
-    pub kind: IntegratorKind,
-    /// -1 = unbounded.
-    pub max_depth: i32,
-    pub rr_depth: i32,
-    pub hide_emitters: bool,
-    /// Wrapped in `moment`: also output the per-pixel second moment.
-    pub moment: bool,
-    /// `volpath_snee`'s `snee` and `transport` options (defaults elsewhere).
-    pub snee: SneeOptions,
-}
-
-impl Default for IntegratorDesc {
-    fn default() -> Self {
-        IntegratorDesc {
-            kind: IntegratorKind::Path,
-            max_depth: -1,
-            rr_depth: 5,
-            hide_emitters: false,
-            moment: false,
-            snee: SneeOptions::default(),
+/// The integrator for `scene` (whose own `integrator` field is not read), with its tables.
+pub fn build(desc: IntegratorDesc, scene: &Scene) -> Integrator {
+    match desc.kind {
+        IntegratorKind::Path => Integrator::Path(desc),
+        IntegratorKind::Volpath => Integrator::Volpath(desc),
+        IntegratorKind::Volpathmis => Integrator::Volpathmis(desc),
+        IntegratorKind::VolpathSnee => {
+            let snee = volpath_snee::build(scene, desc.snee);
+            Integrator::VolpathSnee(desc, snee)
         }
     }
 }
 
-impl IntegratorDesc {
-    pub fn from_desc(obj: &ObjectDesc) -> Result<IntegratorDesc> {
-        let props = &obj.props;
-        if obj.plugin == "moment" {
-            let nested = props.objects_of(PluginKind::Integrator);
-            props.finish()?;
-            let Some((_, first)) = nested.first() else {
-                return Err(Error::at(&obj.pos, "moment: expects a nested integrator"));
-            };
-            if nested.len() > 1 {
-                return Err(Error::at(&nested[1].1.pos, "moment: only one nested integrator is supported"));
-            }
-            let mut inner = IntegratorDesc::from_desc(first)?;
-            inner.moment = true;
-            return Ok(inner);
+impl Integrator {
+    /// Radiance along one camera ray (which starts in the sensor's medium), and whether the ray is
+    /// "valid" (the alpha channel).
+    #[inline]
+    pub fn li(&self, scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
+        let medium = scene.sensor_medium;
+        match self {
+            Integrator::Path(_) => path::li(scene, sampler, ray, stats),
+            Integrator::Volpath(_) => volpath::li(scene, sampler, ray, medium, stats),
+            Integrator::Volpathmis(_) => volpathmis::li(scene, sampler, ray, medium, stats),
+            Integrator::VolpathSnee(_, snee) => volpath_snee::li(scene, snee, sampler, ray, medium, stats),
         }
-        let kind = match obj.plugin.as_str() {
-            "path" => IntegratorKind::Path,
-            "volpath" => IntegratorKind::Volpath,
-            "volpathmis" => IntegratorKind::Volpathmis,
-            "volpath_snee" => IntegratorKind::VolpathSnee,
-            other => {
-                return Err(Error::at(
-                    &obj.pos,
-                    format!(
-                    "integrator \"{}\" is not supported (supported: path, volpath, volpathmis, volpath_snee, moment)",
-                    other
-                ),
-                ))
-            }
-        };
-        let max_depth = props.int("max_depth", -1)?;
-        if max_depth < -1 {
-            return Err(props.error("max_depth", "max_depth must be -1 (unbounded) or non-negative"));
-        }
-        let rr_depth = props.int("rr_depth", 5)?;
-        if rr_depth <= 0 {
-            return Err(props.error("rr_depth", "rr_depth must be positive"));
-        }
-        let hide_emitters = props.bool("hide_emitters", false)?;
-        let mut snee = SneeOptions::default();
-        if kind == IntegratorKind::VolpathSnee {
-            snee.technique = match props.string("snee", "mis")?.as_str() {
-                "mis" => SneeTechnique::Mis,
-                "snee" => SneeTechnique::Snee,
-                "forward" => SneeTechnique::Forward,
-                other => {
-                    return Err(props
-                        .error("snee", format!("volpath_snee: snee = \"{}\" is not one of mis, snee, forward", other)))
-                }
-            };
-            snee.rate = props.float_opt("snee_rate")?;
-            if let Some(r) = snee.rate {
-                if !(0.0..=1.0).contains(&r) {
-                    return Err(props.error("snee_rate", "volpath_snee: snee_rate must be in [0, 1]"));
-                }
-            }
-            snee.transport = match props.string("transport", "all")?.as_str() {
-                "all" => SneeTransport::All,
-                "snee" => SneeTransport::Snee,
-                other => {
-                    return Err(props.error(
-                        "transport",
-                        format!("volpath_snee: transport = \"{}\" is not one of all, snee", other),
-                    ))
-                }
-            };
-        }
-        props.finish()?;
-        let clamp = |v: i64| v.clamp(-1, i32::MAX as i64) as i32;
-        Ok(IntegratorDesc {
-            kind,
-            max_depth: clamp(max_depth),
-            rr_depth: clamp(rr_depth),
-            hide_emitters,
-            moment: false,
-            snee,
-        })
     }
 }

@@ -41,17 +41,14 @@
 //! and its volpath returns NaN; we do not reproduce that.
 
 use super::stats::LocalStats;
-use super::volpath::{is_medium_transition, target_medium, RefPoint};
+use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, walk_segments, PathSetup, RefPoint};
 use crate::bsdf::{flags, BsdfContext};
 use crate::color::Spectrum;
-use crate::interaction::{offset_origin, spawn_ray_between, DirectionSample, SurfaceInteraction};
+use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::{Ray, Vec3};
 use crate::medium::Homogeneous;
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
-
-/// Upper bound on surface crossings of one shadow ray (guards against degenerate geometry).
-const MAX_SHADOW_SEGMENTS: u32 = 256;
 
 /// Number of colour channels, i.e. of hero-channel sampling techniques.
 const N_CHANNELS: f32 = 3.0;
@@ -133,7 +130,7 @@ fn prob_real(m: &Homogeneous) -> Spectrum {
 pub fn sample_emitter(
     scene: &Scene,
     r: RefPoint,
-    mut medium: Option<u32>,
+    medium: Option<u32>,
     p_over_f: &POverF,
     channel: usize,
     sampler: &mut Sampler,
@@ -148,28 +145,10 @@ pub fn sample_emitter(
     let emitted = weight * ds.pdf;
     p_over_f_nee.update(Vec3::splat(ds.pdf), Spectrum::ONE);
 
-    // ---- The shadow ray, from a surface (offset, possibly entering another medium) or a medium point ----
-    let o = match r {
-        RefPoint::Surface(si) => {
-            if is_medium_transition(scene, si) {
-                medium = target_medium(scene, si, ds.d);
-            }
-            offset_origin(si.p, si.n, ds.d)
-        }
-        RefPoint::Medium(p) => p,
-    };
-    let mut ray = if ds.dist.is_finite() { spawn_ray_between(o, ds.p) } else { Ray::new(o, ds.d) };
-
-    // ---- Transmittance: free flights in the hero channel, null interfaces ----
-    let mut remaining = ray.tmax;
-    for _ in 0..MAX_SHADOW_SEGMENTS {
-        if !(remaining > 0.0) {
-            break;
-        }
-        ray.tmax = remaining;
-        stats.rays += 1;
-        let si = scene.ray_intersect(&ray);
-        let seg = si.as_ref().map_or(remaining, |s| s.t);
+    // ---- The shadow ray: free flights in the hero channel, null interfaces ----
+    let (ray, medium) = shadow_ray(scene, r, medium, &ds);
+    let mut blocked = false;
+    walk_segments(scene, ray, medium, stats, |medium, seg, si| {
         if let Some(mi) = medium {
             let m = &scene.media[mi as usize];
             let t = m.sample_distance(sampler.next_1d(), channel);
@@ -179,21 +158,18 @@ pub fn sample_emitter(
             p_over_f_uni.update(pdf, tr);
             if collided {
                 // A real collision: σn = 0, so the null-collision weight p/f is 0/0 → 0.
-                return (POverF::ZERO, POverF::ZERO, emitted, ds);
+                blocked = true;
+                return false;
             }
         }
-        let Some(si) = si else { break };
-        let null_tr = scene.bsdf(&si).eval_null_transmission(&si);
+        let Some(si) = si else { return false };
+        let null_tr = scene.bsdf(si).eval_null_transmission(si);
         p_over_f_nee.update(Spectrum::ONE, null_tr);
         p_over_f_uni.update(Spectrum::ONE, null_tr);
-        if p_over_f_uni.weight() == Spectrum::ZERO {
-            break;
-        }
-        if is_medium_transition(scene, &si) {
-            medium = target_medium(scene, &si, ray.d);
-        }
-        remaining -= si.t;
-        ray.o = offset_origin(si.p, si.n, ray.d);
+        p_over_f_uni.weight() != Spectrum::ZERO
+    });
+    if blocked {
+        return (POverF::ZERO, POverF::ZERO, emitted, ds);
     }
     (p_over_f_nee, p_over_f_uni, emitted, ds)
 }
@@ -237,8 +213,6 @@ pub fn li_with(
     roulette: RouletteMis,
 ) -> (Spectrum, bool) {
     let desc = &scene.integrator;
-    let max_depth = if desc.max_depth < 0 { u32::MAX } else { desc.max_depth as u32 };
-    let rr_depth = desc.rr_depth as u32;
     let ctx = BsdfContext::default();
 
     // ---- Path state ----
@@ -252,7 +226,7 @@ pub fn li_with(
     // Forward (BSDF / phase sampling) and light-sampling densities over throughput.
     let mut p_over_f = POverF::ONE;
     let mut p_over_f_nee = POverF::ONE;
-    let channel = ((sampler.next_1d() * 3.0) as usize).min(2);
+    let PathSetup { max_depth, rr_depth, channel } = PathSetup::new(scene, sampler);
     let mut last_scatter_p = ray.o;
     // The surface hit along the current ray, when already traced.
     let mut si: Option<SurfaceInteraction> = None;
@@ -279,16 +253,9 @@ pub fn li_with(
         let mut escaped_medium = false;
         if let Some(mi) = medium {
             let m = &scene.media[mi as usize];
-            let t = m.sample_distance(sampler.next_1d(), channel);
-            if needs_intersection {
-                let mut r = ray;
-                r.tmax = t;
-                stats.rays += 1;
-                si = scene.ray_intersect(&r);
-                needs_intersection = false;
-            }
+            let flight = free_flight(scene, m, &ray, channel, &mut si, &mut needs_intersection, sampler, stats);
+            let (t, scatter) = (flight.t, flight.scatter);
             let t_surface = si.as_ref().map_or(f32::INFINITY, |s| s.t);
-            let scatter = t < t_surface;
             let (tr, pdf) = tr_and_pdf(m, t.min(t_surface), scatter);
             p_over_f.update(pdf, tr);
             p_over_f_nee.update(pdf, tr);

@@ -9,7 +9,7 @@ use super::xml::ParsedScene;
 use super::{Error, Result};
 use crate::bsdf::Bsdf;
 use crate::emitter::Emitter;
-use crate::integrator::IntegratorDesc;
+use crate::integrator::{self, Integrator, IntegratorDesc};
 use crate::math::{Aabb, Vec3};
 use crate::medium::Homogeneous;
 use crate::sensor::Sensor;
@@ -73,7 +73,7 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
                         format!("a scene has at most one integrator (the first is at {})", first),
                     ));
                 }
-                integrator = Some((IntegratorDesc::from_desc(&obj)?, obj.pos.clone()));
+                integrator = Some((integrator::parse(&obj)?, obj.pos.clone()));
             }
             PluginKind::Sensor => {
                 if let Some(first) = &sensor_pos {
@@ -166,11 +166,11 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         film: sensor.film,
         sampler: sensor.sampler,
         sensor_medium,
-        integrator,
+        // Replaced below: the integrator's tables are built from the finished scene.
+        integrator: Integrator::Path(IntegratorDesc::default()),
         bounds,
-        snee_rates: Vec::new(),
     };
-    scene.snee_rates = crate::integrator::snee::medium_rates(&scene);
+    scene.integrator = integrator::build(integrator, &scene);
     Ok(scene)
 }
 

@@ -1,10 +1,10 @@
 //! The built scene: shapes with their BVH, BSDFs, emitters, media, the sensor and the integrator
-//! settings; ray queries and emitter sampling (Mitsuba's `Scene`).
+//! (built with its tables); ray queries and emitter sampling (Mitsuba's `Scene`).
 
 use crate::bsdf::Bsdf;
 use crate::color::Spectrum;
 use crate::emitter::Emitter;
-use crate::integrator::IntegratorDesc;
+use crate::integrator::desc::Integrator;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
 use crate::medium::Homogeneous;
@@ -40,11 +40,9 @@ pub struct Scene {
     pub sampler: SamplerDesc,
     /// Medium the camera sits in.
     pub sensor_medium: Option<u32>,
-    pub integrator: IntegratorDesc,
+    /// The integrator, built with its tables at scene load.
+    pub integrator: Integrator,
     pub bounds: Aabb,
-    /// Per medium: `None` where SNEE does not apply, else the probability `r` that
-    /// `volpath_snee` runs SNEE at one of its scattering vertices (`integrator::snee::medium_rates`).
-    pub snee_rates: Vec<Option<f32>>,
 }
 
 impl Scene {

@@ -2,7 +2,14 @@
 //! (docs/snee.md §3): one weight function, called with the same densities whichever technique
 //! produced the path.
 
-use super::SneeTechnique;
+use super::light::{light_transmission, segment_clear};
+use super::options::{Snee, SneeTechnique};
+use super::pdf::suffix_pdfs;
+use super::{LightSample, SneeSuffix};
+use crate::color::Spectrum;
+use crate::integrator::stats::LocalStats;
+use crate::interaction::offset_origin;
+use crate::scene::world::Scene;
 
 /// Densities of one suffix under every technique, in the common measure of docs/snee.md §1.
 #[derive(Clone, Copy, Debug, Default)]
@@ -40,6 +47,53 @@ pub fn suffix_weights(technique: SneeTechnique, p: SuffixPdfs) -> SuffixWeights 
         return SuffixWeights::default();
     }
     SuffixWeights { snee: a / sum, fwd_nee: b / sum, fwd_bsdf: c / sum }
+}
+
+/// Which forward technique produced a suffix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ForwardTechnique {
+    /// Emitter sampling at a rough `x_k`.
+    Nee,
+    /// BSDF sampling at `x_k` (rough, or the smooth refraction) that hit the emitter.
+    Bsdf,
+}
+
+/// The weight of a forward contribution through the suffix `s` towards `light`, or `None` when
+/// SNEE cannot produce that path (then volpath's own weight applies). In `forward` mode the
+/// caller's `w_volpath` is returned for paths in SNEE's support.
+#[allow(clippy::too_many_arguments)]
+pub fn forward_weight(
+    scene: &Scene,
+    snee: &Snee,
+    s: &SneeSuffix,
+    light: &LightSample,
+    technique: ForwardTechnique,
+    w_volpath: f32,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<f32> {
+    if light.omega_l.dot(s.si_k.n) <= 0.0 {
+        return None;
+    }
+    // SNEE's support: x_k is the probe's first hit from x_i, the light segment is clear.
+    let inner_k = offset_origin(s.si_k.p, s.si_k.n, s.x_i.p - s.si_k.p);
+    if !segment_clear(scene, s.x_i.p, inner_k, stats)
+        || light_transmission(scene, &s.si_k, light, stats) == Spectrum::ZERO
+    {
+        return None;
+    }
+    let pdfs = suffix_pdfs(scene, snee, s, light, channel);
+    if !(pdfs.snee > 0.0) {
+        return None;
+    }
+    if snee.options.technique == SneeTechnique::Forward {
+        return Some(w_volpath);
+    }
+    let w = suffix_weights(snee.options.technique, pdfs);
+    Some(match technique {
+        ForwardTechnique::Nee => w.fwd_nee,
+        ForwardTechnique::Bsdf => w.fwd_bsdf,
+    } as f32)
 }
 
 #[cfg(test)]

@@ -1,0 +1,58 @@
+//! `volpath_snee`'s options (its XML parameters, parsed in `integrator/volpath_snee.rs`) and the
+//! tables built from them once at scene load ([`Snee`]). Plain data: the scene stores it.
+
+/// How SNEE and forward tracing share the suffixes both can produce (`snee` parameter).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SneeTechnique {
+    Mis,
+    Snee,
+    Forward,
+}
+
+/// Which light transport is rendered (`transport` parameter).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SneeTransport {
+    All,
+    /// Only the suffixes `x_i → x_j → x_k → emitter` in SNEE's support.
+    Snee,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SneeOptions {
+    pub technique: SneeTechnique,
+    pub transport: SneeTransport,
+    /// `snee_rate`; `None`: [`auto_rate`] per medium.
+    pub rate: Option<f32>,
+}
+
+impl Default for SneeOptions {
+    fn default() -> Self {
+        SneeOptions { technique: SneeTechnique::Mis, transport: SneeTransport::All, rate: None }
+    }
+}
+
+impl SneeOptions {
+    /// Does forward tracing need SNEE's density of its suffixes (for MIS or for the transport filter)?
+    #[inline]
+    pub fn needs_suffix_pdf(&self) -> bool {
+        self.technique != SneeTechnique::Forward || self.transport == SneeTransport::Snee
+    }
+    /// Are contributions outside SNEE's suffixes kept?
+    #[inline]
+    pub fn keeps_all(&self) -> bool {
+        self.transport == SneeTransport::All
+    }
+}
+
+/// `volpath_snee` as built at scene load: its options and the per-medium tables SNEE reads at every
+/// vertex (computed once by `snee::rate::build`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snee {
+    pub options: SneeOptions,
+    /// Per medium: `None` where SNEE does not apply, else the probability `r` that SNEE runs at
+    /// one of its scattering vertices (docs/snee.md §5).
+    pub rates: Vec<Option<f32>>,
+    /// Does the scene have a non-delta emitter (area, envmap, constant, ...)? Decides the mixture
+    /// of ↓ and ↑ at a smooth boundary (docs/snee.md §2.5).
+    pub has_non_delta_emitter: bool,
+}

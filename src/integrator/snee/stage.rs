@@ -1,0 +1,158 @@
+//! SNEE as one stage of the volpath loop (docs/snee.md §3): its per-path state and the five
+//! places where the loop asks it something. The loop owns the path; this type never edits it.
+//!
+//! | loop event                     | call                       | what SNEE does                              |
+//! |--------------------------------|----------------------------|---------------------------------------------|
+//! | real scatter `p` in a medium   | [`SneeStage::at_scatter`]  | `x_j` of a chain from the last `x_i`; a new `x_i`; one SNEE sample (the technique's `sample`) |
+//! | the ray reaches a surface      | [`SneeStage::at_surface`]  | recognises `x_k` after `x_i → x_j`          |
+//! | an emitter is hit              | [`SneeStage::weight_hit`]  | the MIS weight of forward BSDF sampling through `x_k` (the technique's `pdf` of that suffix) |
+//! | emitter sampling at a surface  | [`SneeStage::weight_nee`]  | the MIS weight of forward NEE at `x_k`      |
+//! | BSDF sampling at a surface     | [`SneeStage::after_bsdf`]  | carries the suffix across `x_k` and passable surfaces |
+
+use super::mis::{forward_weight, ForwardTechnique};
+use super::options::{Snee, SneeTechnique};
+use super::rate::snee_vertex;
+use super::{encloses, passable, LightSample, SneeSuffix, SneeVertex};
+use crate::bsdf::{flags, BsdfSample};
+use crate::color::Spectrum;
+use crate::integrator::stats::LocalStats;
+use crate::integrator::technique::Technique;
+use crate::interaction::SurfaceInteraction;
+use crate::math::Vec3;
+use crate::sampler::Sampler;
+use crate::scene::world::Scene;
+
+/// SNEE's state along one path.
+#[derive(Clone, Debug)]
+pub struct SneeStage<'a> {
+    snee: &'a Snee,
+    /// x_i: the last real scatter, when SNEE runs there and no surface event followed.
+    x_i: Option<SneeVertex>,
+    /// (x_i, x_j): the scatter x_j directly after a SNEE vertex x_i.
+    chain: Option<(SneeVertex, Vec3)>,
+    /// The suffix x_i → x_j → x_k at the current boundary vertex.
+    at_k: Option<SneeSuffix>,
+    /// The suffix the ray leaving the last surface carries (after refraction at x_k).
+    pending: Option<SneeSuffix>,
+    /// `pending` as it was when the ray reached the current surface.
+    arrived: Option<SneeSuffix>,
+}
+
+impl<'a> SneeStage<'a> {
+    pub fn new(snee: &'a Snee) -> Self {
+        SneeStage { snee, x_i: None, chain: None, at_k: None, pending: None, arrived: None }
+    }
+
+    /// Are contributions outside SNEE's suffixes kept (`transport = all`)?
+    #[inline]
+    pub fn keeps_all(&self) -> bool {
+        self.snee.options.keeps_all()
+    }
+
+    /// At a real scatter `p` (depth `depth`) in `medium`: the chain `x_i → x_j = p` if `x_i` was the
+    /// last vertex, `p` as the new `x_i`, and one SNEE sample there. Returns its contribution
+    /// (`beta` is the throughput at `p` including `sigma_s`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn at_scatter(
+        &mut self,
+        scene: &Scene,
+        medium: u32,
+        p: Vec3,
+        wi: Vec3,
+        depth: u32,
+        max_depth: u32,
+        beta: Spectrum,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        self.chain = self.x_i.take().map(|x_i| (x_i, p));
+        self.x_i = snee_vertex(self.snee, medium, p, wi, depth, max_depth);
+        match &self.x_i {
+            Some(x_i) if self.snee.options.technique != SneeTechnique::Forward => {
+                self.snee.sample(scene, x_i, beta, channel, sampler, stats)
+            }
+            _ => Spectrum::ZERO,
+        }
+    }
+
+    /// The ray along `d` reached a surface (`None`: it escaped). A surface event ends SNEE chains;
+    /// it is `x_k` when it follows `x_i → x_j` on a boundary enclosing `x_i`'s medium.
+    #[inline]
+    pub fn at_surface(&mut self, scene: &Scene, si: Option<&SurfaceInteraction>, d: Vec3) {
+        self.x_i = None;
+        self.at_k = match (self.chain.take(), si) {
+            (Some((x_i, x_j)), Some(s)) if encloses(scene, s, x_i.medium, d) => Some(SneeSuffix { x_i, x_j, si_k: *s }),
+            _ => None,
+        };
+        self.arrived = self.pending.take();
+    }
+
+    /// The weight of an emitter hit by forward BSDF sampling whose volpath weight is `w_volpath`.
+    #[inline]
+    pub fn weight_hit(
+        &self,
+        scene: &Scene,
+        light: impl FnOnce() -> LightSample,
+        w_volpath: f32,
+        channel: usize,
+        stats: &mut LocalStats,
+    ) -> f32 {
+        self.weight(scene, self.arrived.as_ref(), light, ForwardTechnique::Bsdf, w_volpath, channel, stats)
+    }
+
+    /// The weight of forward emitter sampling at the current surface, volpath weight `w_volpath`.
+    #[inline]
+    pub fn weight_nee(
+        &self,
+        scene: &Scene,
+        light: impl FnOnce() -> LightSample,
+        w_volpath: f32,
+        channel: usize,
+        stats: &mut LocalStats,
+    ) -> f32 {
+        self.weight(scene, self.at_k.as_ref(), light, ForwardTechnique::Nee, w_volpath, channel, stats)
+    }
+
+    /// BSDF sampling at `s` chose `bs` towards `wo`: a refraction out of `x_k` carries its suffix
+    /// on, and so does a null crossing of a passable surface (docs/snee.md §1).
+    #[inline]
+    pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
+        let non_null = bs.sampled_type & flags::NULL == 0;
+        if bs.sampled_type & flags::TRANSMISSION != 0 && non_null && wo.dot(s.n) > 0.0 {
+            self.pending = self.at_k;
+        } else if !non_null && passable(scene, s) {
+            self.pending = self.arrived;
+        }
+    }
+
+    /// The weight of a forward contribution that may end a SNEE suffix: the joint MIS weight for
+    /// suffixes in SNEE's support, and `w_volpath` (transport = all) or 0 (transport = snee) for
+    /// the others.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn weight(
+        &self,
+        scene: &Scene,
+        suffix: Option<&SneeSuffix>,
+        light: impl FnOnce() -> LightSample,
+        technique: ForwardTechnique,
+        w_volpath: f32,
+        channel: usize,
+        stats: &mut LocalStats,
+    ) -> f32 {
+        let opts = self.snee.options;
+        let w = match suffix {
+            Some(s) if opts.needs_suffix_pdf() => {
+                forward_weight(scene, self.snee, s, &light(), technique, w_volpath, channel, stats)
+            }
+            _ => None,
+        };
+        match w {
+            Some(w) => w,
+            None if opts.keeps_all() => w_volpath,
+            None => 0.0,
+        }
+    }
+}

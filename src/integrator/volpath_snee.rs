@@ -1,0 +1,75 @@
+//! `volpath_snee`: volpath with subdivision next-event estimation (Koerner et al. 2016, the
+//! technique in `integrator/snee/`), combined with forward path tracing by multiple importance
+//! sampling (`docs/snee.md`).
+//!
+//! | Parameter    | Type    | Description                                                        |
+//! |--------------|---------|--------------------------------------------------------------------|
+//! | `max_depth`, `rr_depth`, `hide_emitters` | | as `volpath`                                |
+//! | `snee`       | string  | `mis` (default): SNEE and forward tracing by MIS; `snee`: SNEE alone where it applies; `forward`: forward alone (= volpath) |
+//! | `transport`  | string  | `all` (default); `snee`: only paths whose last two scattering vertices before leaving through the boundary are medium vertices, in SNEE's support (the paper's Figure 3) |
+//! | `snee_rate`  | float   | probability `r` of running SNEE at a scattering vertex (default: chosen per medium from its boundary and the lights, see [`snee::auto_rate`]); MIS counts SNEE's density as `r · pdf_snee`, so any `r` is unbiased |
+//!
+//! ```xml
+//! <integrator type="volpath_snee">
+//!     <integer name="max_depth" value="-1"/>
+//!     <string name="snee" value="mis"/>
+//!     <string name="transport" value="all"/>
+//! </integrator>
+//! ```
+
+use super::snee::{self, Snee, SneeOptions, SneeTechnique, SneeTransport};
+use super::stats::LocalStats;
+use super::volpath;
+use crate::color::Spectrum;
+use crate::math::Ray;
+use crate::sampler::Sampler;
+use crate::scene::desc::Props;
+use crate::scene::world::Scene;
+use crate::scene::Result;
+
+/// Radiance along a camera ray: volpath's loop with SNEE as one stage.
+pub fn li(
+    scene: &Scene,
+    snee: &Snee,
+    sampler: &mut Sampler,
+    ray: Ray,
+    medium: Option<u32>,
+    stats: &mut LocalStats,
+) -> (Spectrum, bool) {
+    volpath::li_with(scene, sampler, ray, medium, stats, Some(snee))
+}
+
+/// The `snee`, `snee_rate` and `transport` parameters.
+pub fn parse_options(props: &Props) -> Result<SneeOptions> {
+    let technique = match props.string("snee", "mis")?.as_str() {
+        "mis" => SneeTechnique::Mis,
+        "snee" => SneeTechnique::Snee,
+        "forward" => SneeTechnique::Forward,
+        other => {
+            return Err(
+                props.error("snee", format!("volpath_snee: snee = \"{}\" is not one of mis, snee, forward", other))
+            )
+        }
+    };
+    let rate = props.float_opt("snee_rate")?;
+    if let Some(r) = rate {
+        if !(0.0..=1.0).contains(&r) {
+            return Err(props.error("snee_rate", "volpath_snee: snee_rate must be in [0, 1]"));
+        }
+    }
+    let transport = match props.string("transport", "all")?.as_str() {
+        "all" => SneeTransport::All,
+        "snee" => SneeTransport::Snee,
+        other => {
+            return Err(
+                props.error("transport", format!("volpath_snee: transport = \"{}\" is not one of all, snee", other))
+            )
+        }
+    };
+    Ok(SneeOptions { technique, transport, rate })
+}
+
+/// SNEE's tables for `scene` (per-medium rates, emitter mixture), built once at scene load.
+pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
+    snee::rate::build(scene, options)
+}
