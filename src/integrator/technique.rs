@@ -9,7 +9,7 @@
 //!   another technique made (0 outside its support), in the common measure of docs/snee.md §1.
 //!
 //! MIS is one function over all techniques' densities of the same suffix:
-//! `snee::mis::suffix_weights` over `snee::mis::SuffixPdfs` (power heuristic; forward NEE and forward BSDF
+//! `snee::mis::suffix_weights` over `snee::pdf::SuffixPdfs` (power heuristic; forward NEE and forward BSDF
 //! sampling at `x_k` report their densities through `snee::pdf::suffix_pdfs`). A technique's
 //! per-path bookkeeping (which vertices are `x_i`, `x_j`, `x_k` of the current path) lives in its
 //! own stage type, called once per loop event (`snee::stage`), never in the loop's variables.
@@ -18,7 +18,7 @@
 //! built tables, add its density as a field of `SuffixPdfs` and its weight to
 //! `suffix_weights`, and call its `sample` from the stage at a scatter.
 
-use super::snee::{LightSample, SneeSuffix, SneeVertex};
+use super::snee::{self, LightSample, Snee, SneeSuffix, SneeVertex};
 use super::stats::LocalStats;
 use crate::color::Spectrum;
 use crate::sampler::Sampler;
@@ -42,4 +42,25 @@ pub trait Technique {
     /// The density with which this technique makes the suffix `s` ending at `light` (including the
     /// probability that it runs at `x_i`); 0 outside its support. Visibility is the caller's.
     fn pdf(&self, scene: &Scene, s: &SneeSuffix, light: &LightSample, channel: usize) -> f64;
+}
+
+/// SNEE (`snee/`): `sample` is `snee::sample`, `pdf` is `snee::pdf_snee`.
+impl Technique for Snee {
+    #[inline]
+    fn sample(
+        &self,
+        scene: &Scene,
+        x_i: &SneeVertex,
+        beta: Spectrum,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        snee::sample(scene, x_i, beta, channel, self, sampler, stats)
+    }
+
+    #[inline]
+    fn pdf(&self, scene: &Scene, s: &SneeSuffix, light: &LightSample, channel: usize) -> f64 {
+        snee::pdf_snee(scene, self, s, light, channel)
+    }
 }

@@ -4,24 +4,12 @@
 
 use super::light::{light_transmission, segment_clear};
 use super::options::{Snee, SneeTechnique};
-use super::pdf::suffix_pdfs;
+use super::pdf::{suffix_pdfs, SuffixPdfs};
 use super::{LightSample, SneeSuffix};
 use crate::color::Spectrum;
 use crate::integrator::stats::LocalStats;
 use crate::interaction::offset_origin;
 use crate::scene::world::Scene;
-
-/// Densities of one suffix under every technique, in the common measure of docs/snee.md §1.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct SuffixPdfs {
-    /// `pdf_snee` (0 outside SNEE's support).
-    pub snee: f64,
-    /// `p_fwd · p_light(omega_l)`: forward NEE at a rough `x_k` (0 at a smooth one).
-    pub fwd_nee: f64,
-    /// `p_fwd · bsdf.pdf(omega_kj → omega_l)` at a rough `x_k`, `p_fwd · (1 − F)` at a smooth one
-    /// (0 for delta emitters, which cannot be hit).
-    pub fwd_bsdf: f64,
-}
 
 /// MIS weights of the three techniques; they sum to 1 whenever some density is positive.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

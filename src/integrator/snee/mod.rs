@@ -38,13 +38,10 @@ pub use rate::{auto_rate, medium_rates, snee_vertex, AUTO_RATE_SHARED};
 pub use sample::sample;
 pub use stage::SneeStage;
 
-use super::stats::LocalStats;
-use super::technique::Technique;
 use crate::bsdf::Bsdf;
 use crate::color::Spectrum;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::Vec3;
-use crate::sampler::Sampler;
 use crate::scene::world::Scene;
 /// A SNEE vertex `x_i`: a real scatter where SNEE runs (docs/snee.md §0).
 #[derive(Clone, Copy, Debug)]
@@ -128,24 +125,4 @@ pub fn encloses(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3) ->
 #[inline]
 pub fn with_wi(si_k: &SurfaceInteraction, omega_kj: Vec3) -> SurfaceInteraction {
     SurfaceInteraction { wi: si_k.to_local(omega_kj), ..*si_k }
-}
-
-impl Technique for Snee {
-    #[inline]
-    fn sample(
-        &self,
-        scene: &Scene,
-        x_i: &SneeVertex,
-        beta: Spectrum,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
-    ) -> Spectrum {
-        sample::sample(scene, x_i, beta, channel, self, sampler, stats)
-    }
-
-    #[inline]
-    fn pdf(&self, scene: &Scene, s: &SneeSuffix, light: &LightSample, channel: usize) -> f64 {
-        pdf::pdf_snee(scene, self, s, light, channel)
-    }
 }

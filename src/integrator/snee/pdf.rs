@@ -3,15 +3,25 @@
 //! tracing's, in the common measure of §1.
 
 use super::distance::DistanceSampler;
-use super::mis::SuffixPdfs;
 use super::options::Snee;
 use super::rate::mixture;
 use super::{with_wi, Boundary, LightSample, SneeSuffix};
 use crate::bsdf::fresnel::fresnel;
 use crate::bsdf::{BsdfContext, TransportMode};
-use crate::integrator::technique::Technique;
 use crate::math::INV_FOUR_PI;
 use crate::scene::world::Scene;
+
+/// Densities of one suffix under every technique, in the common measure of docs/snee.md §1.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SuffixPdfs {
+    /// `pdf_snee` (0 outside SNEE's support).
+    pub snee: f64,
+    /// `p_fwd · p_light(omega_l)`: forward NEE at a rough `x_k` (0 at a smooth one).
+    pub fwd_nee: f64,
+    /// `p_fwd · bsdf.pdf(omega_kj → omega_l)` at a rough `x_k`, `p_fwd · (1 − F)` at a smooth one
+    /// (0 for delta emitters, which cannot be hit).
+    pub fwd_bsdf: f64,
+}
 
 /// SNEE's density of a suffix (docs/snee.md §2.5) times the rate `r` of running SNEE at `x_i`,
 /// given that it lies in SNEE's support (visibility is the caller's business).
@@ -112,5 +122,5 @@ pub fn suffix_pdfs(scene: &Scene, snee: &Snee, s: &SneeSuffix, light: &LightSamp
         }
     };
     let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
-    SuffixPdfs { snee: snee.pdf(scene, s, light, channel), fwd_nee: finite(fwd_nee), fwd_bsdf: finite(fwd_bsdf) }
+    SuffixPdfs { snee: pdf_snee(scene, snee, s, light, channel), fwd_nee: finite(fwd_nee), fwd_bsdf: finite(fwd_bsdf) }
 }
