@@ -15,7 +15,7 @@
 //! - "Specular chains" (paths whose last non-null event was a delta lobe, or a medium vertex that
 //!   does not sample emitters) count an emitter they hit at full weight.
 
-use super::snee::{LightSample, Snee, SneeStage};
+use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
 use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, walk_segments, PathSetup, RefPoint};
 use crate::bsdf::{flags, BsdfContext};
@@ -233,7 +233,7 @@ pub fn li_with(
             let mut w = if count_direct { 1.0 } else { mis_weight(last_scatter_pdf, p_light()) };
             if let Some(snee) = &snee {
                 let light = || LightSample::hit(ray.d, light_p, ds.dist, p_light());
-                w = snee.weight_hit(scene, light, w, channel, stats);
+                w = snee.weight(scene, ForwardTechnique::Bsdf, light, w, channel, stats);
             }
             result += beta * le * w;
         }
@@ -248,7 +248,7 @@ pub fn li_with(
                 let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &s, wo);
                 let mut w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { bsdf_pdf });
                 if let Some(snee) = &snee {
-                    w = snee.weight_nee(scene, || LightSample::sampled(&ds), w, channel, stats);
+                    w = snee.weight(scene, ForwardTechnique::Nee, || LightSample::sampled(&ds), w, channel, stats);
                 }
                 result += beta * bsdf_val * w * emitted;
             }

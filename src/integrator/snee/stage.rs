@@ -5,8 +5,8 @@
 //! |--------------------------------|----------------------------|---------------------------------------------|
 //! | real scatter `p` in a medium   | [`SneeStage::at_scatter`]  | `x_j` of a chain from the last `x_i`; a new `x_i`; one SNEE sample (the technique's `sample`) |
 //! | the ray reaches a surface      | [`SneeStage::at_surface`]  | recognises `x_k` after `x_i → x_j`          |
-//! | an emitter is hit              | [`SneeStage::weight_hit`]  | the MIS weight of forward BSDF sampling through `x_k` (the technique's `pdf` of that suffix) |
-//! | emitter sampling at a surface  | [`SneeStage::weight_nee`]  | the MIS weight of forward NEE at `x_k`      |
+//! | an emitter is hit              | [`SneeStage::weight`]      | the MIS weight of forward BSDF sampling through `x_k` (the technique's `pdf` of that suffix) |
+//! | emitter sampling at a surface  | [`SneeStage::weight`]      | the MIS weight of forward NEE at `x_k`      |
 //! | BSDF sampling at a surface     | [`SneeStage::after_bsdf`]  | carries the suffix across `x_k` and passable surfaces |
 
 use super::mis::{forward_weight, ForwardTechnique};
@@ -89,30 +89,36 @@ impl<'a> SneeStage<'a> {
         self.arrived = self.pending.take();
     }
 
-    /// The weight of an emitter hit by forward BSDF sampling whose volpath weight is `w_volpath`.
+    /// The weight of a forward contribution with volpath weight `w_volpath`: an emitter hit by
+    /// BSDF sampling ([`ForwardTechnique::Bsdf`], through the suffix the ray carries) or emitter
+    /// sampling at the current surface ([`ForwardTechnique::Nee`], through `x_k`).
     #[inline]
-    pub fn weight_hit(
+    pub fn weight(
         &self,
         scene: &Scene,
+        technique: ForwardTechnique,
         light: impl FnOnce() -> LightSample,
         w_volpath: f32,
         channel: usize,
         stats: &mut LocalStats,
     ) -> f32 {
-        self.weight(scene, self.arrived.as_ref(), light, ForwardTechnique::Bsdf, w_volpath, channel, stats)
-    }
-
-    /// The weight of forward emitter sampling at the current surface, volpath weight `w_volpath`.
-    #[inline]
-    pub fn weight_nee(
-        &self,
-        scene: &Scene,
-        light: impl FnOnce() -> LightSample,
-        w_volpath: f32,
-        channel: usize,
-        stats: &mut LocalStats,
-    ) -> f32 {
-        self.weight(scene, self.at_k.as_ref(), light, ForwardTechnique::Nee, w_volpath, channel, stats)
+        let suffix = match technique {
+            ForwardTechnique::Bsdf => self.arrived.as_ref(),
+            ForwardTechnique::Nee => self.at_k.as_ref(),
+        };
+        let opts = self.snee.options;
+        let w = match suffix {
+            Some(s) if opts.needs_suffix_pdf() => {
+                forward_weight(scene, self.snee, s, &light(), technique, w_volpath, channel, stats)
+            }
+            _ => None,
+        };
+        // Outside SNEE's support: volpath's weight (transport = all) or nothing (transport = snee).
+        match w {
+            Some(w) => w,
+            None if opts.keeps_all() => w_volpath,
+            None => 0.0,
+        }
     }
 
     /// BSDF sampling at `s` chose `bs` towards `wo`: a refraction out of `x_k` carries its suffix
@@ -124,35 +130,6 @@ impl<'a> SneeStage<'a> {
             self.pending = self.at_k;
         } else if !non_null && passable(scene, s) {
             self.pending = self.arrived;
-        }
-    }
-
-    /// The weight of a forward contribution that may end a SNEE suffix: the joint MIS weight for
-    /// suffixes in SNEE's support, and `w_volpath` (transport = all) or 0 (transport = snee) for
-    /// the others.
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn weight(
-        &self,
-        scene: &Scene,
-        suffix: Option<&SneeSuffix>,
-        light: impl FnOnce() -> LightSample,
-        technique: ForwardTechnique,
-        w_volpath: f32,
-        channel: usize,
-        stats: &mut LocalStats,
-    ) -> f32 {
-        let opts = self.snee.options;
-        let w = match suffix {
-            Some(s) if opts.needs_suffix_pdf() => {
-                forward_weight(scene, self.snee, s, &light(), technique, w_volpath, channel, stats)
-            }
-            _ => None,
-        };
-        match w {
-            Some(w) => w,
-            None if opts.keeps_all() => w_volpath,
-            None => 0.0,
         }
     }
 }
