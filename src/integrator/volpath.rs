@@ -14,8 +14,16 @@
 //!   (track-length transmittance estimate in the path's channel); dielectrics block them.
 //! - "Specular chains" (paths whose last non-null event was a delta lobe, or a medium vertex that
 //!   does not sample emitters) count an emitter they hit at full weight.
+//!
+//! The loop ([`trace`]) is shared with `volpathmis`: what differs, how the path's weight is carried
+//! and how MIS weighs emitter sampling against BSDF / phase sampling, is a [`PathWeight`]
+//! ([`Beta`] here: the throughput and the power heuristic). `volpath_snee` is this loop with SNEE
+//! as one more stage ([`SneeStage`]).
 
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
+use crate::bsdf::{Bsdf, BsdfSample};
+use crate::medium::Homogeneous;
+use crate::math::Vec3;
 use super::stats::LocalStats;
 use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, walk_segments, PathSetup, RefPoint};
 use crate::bsdf::{flags, BsdfContext};
@@ -92,9 +100,7 @@ pub fn li(
     li_with(scene, sampler, ray, medium, stats, None)
 }
 
-/// volpath's loop; with `snee`, the `volpath_snee` integrator (SNEE as one stage,
-/// [`SneeStage`], which also weighs the forward suffixes SNEE can produce). With `None` this is
-/// Mitsuba's volpath.
+/// volpath's loop; with `snee`, the `volpath_snee` integrator. With `None` this is Mitsuba's volpath.
 pub fn li_with(
     scene: &Scene,
     sampler: &mut Sampler,
@@ -103,44 +109,270 @@ pub fn li_with(
     stats: &mut LocalStats,
     snee: Option<&Snee>,
 ) -> (Spectrum, bool) {
+    let weight = Beta { beta: Spectrum::ONE, last_scatter_pdf: 1.0 };
+    trace(scene, sampler, ray, medium, stats, weight, snee.map(SneeStage::new))
+}
+
+/// An emitter the path's ray hit: its radiance, the direction sample from the last scattering
+/// vertex `from` (for MIS densities), and the point SNEE's light record uses.
+#[derive(Clone, Copy, Debug)]
+pub struct EmitterHit {
+    pub le: Spectrum,
+    pub ds: DirectionSample,
+    pub from: Vec3,
+    pub light_p: Vec3,
+}
+
+/// What the path loop asks of its estimator at each event (`volpath`: [`Beta`]; `volpathmis`: its
+/// spectral-MIS densities). Each method draws exactly the samples its estimator draws.
+pub trait PathWeight {
+    /// Russian roulette and the weight-dependent end of the path at the loop head; `false` ends it.
+    fn roulette(&mut self, depth: u32, setup: &PathSetup, eta: f32, sampler: &mut Sampler) -> bool;
+    /// A free flight in `m` of sampled length `t` ended at `min(t, t_surface)`, by a real collision
+    /// when `scatter`.
+    fn flight(&mut self, m: &Homogeneous, t: f32, t_surface: f32, scatter: bool, channel: usize);
+    /// A real collision (albedo and the null-or-real decision).
+    fn real_scatter(&mut self, m: &Homogeneous);
+    /// Emitter sampling at the medium vertex `p`: its contribution.
+    #[allow(clippy::too_many_arguments)]
+    fn medium_emitter_sampling(
+        &mut self,
+        scene: &Scene,
+        m: &Homogeneous,
+        p: Vec3,
+        wi: Vec3,
+        medium: Option<u32>,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum;
+    /// Phase sampling gave `(weight, pdf)`; `false` ends the path.
+    fn phase_sampled(&mut self, phase_weight: f32, phase_pdf: f32) -> bool;
+    /// The contribution of an emitter hit by the path (`count_direct`: at full weight).
+    #[allow(clippy::too_many_arguments)]
+    fn emitter_hit(
+        &mut self,
+        scene: &Scene,
+        hit: &EmitterHit,
+        ray_d: Vec3,
+        count_direct: bool,
+        snee: Option<&SneeStage>,
+        channel: usize,
+        stats: &mut LocalStats,
+    ) -> Spectrum;
+    /// Emitter sampling at a surface `s` with a smooth BSDF: its contribution.
+    #[allow(clippy::too_many_arguments)]
+    fn surface_emitter_sampling(
+        &mut self,
+        scene: &Scene,
+        s: &SurfaceInteraction,
+        bsdf: &Bsdf,
+        medium: Option<u32>,
+        snee: Option<&SneeStage>,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum;
+    /// Is this BSDF sample usable? (Else the path ends, as a failed sample does.)
+    fn accepts(&self, bs: &BsdfSample) -> bool;
+    /// The path's `valid_ray` after BSDF sampling failed at `bsdf`.
+    fn valid_after_failed_sample(&self, bsdf: &Bsdf, valid_ray: bool) -> bool;
+    /// BSDF sampling chose `bs` with `weight` = f·cos/pdf (`non_null`: a real scattering event).
+    fn bsdf_sampled(&mut self, bs: &BsdfSample, weight: Spectrum, non_null: bool);
+    /// The throughput at the current vertex (for a stage such as SNEE).
+    fn beta(&self) -> Spectrum;
+}
+
+/// volpath's path weight: the throughput `beta` (Tr / pdf[channel] per flight, as Mitsuba's RGB
+/// mode), and the density of the last BSDF / phase sample for the power heuristic.
+#[derive(Clone, Copy, Debug)]
+pub struct Beta {
+    pub beta: Spectrum,
+    pub last_scatter_pdf: f32,
+}
+
+impl PathWeight for Beta {
+    #[inline]
+    fn roulette(&mut self, depth: u32, setup: &PathSetup, eta: f32, sampler: &mut Sampler) -> bool {
+        let beta_max = self.beta.max_element();
+        if !(beta_max > 0.0) || !self.beta.is_finite() {
+            return false;
+        }
+        let q = (beta_max * eta * eta).min(0.95);
+        let u_rr = sampler.next_1d();
+        if depth > setup.rr_depth {
+            if u_rr >= q {
+                return false;
+            }
+            self.beta /= q;
+        }
+        true
+    }
+
+    #[inline]
+    fn flight(&mut self, m: &Homogeneous, t: f32, t_surface: f32, scatter: bool, channel: usize) {
+        // Spectral transmittance ratio: Tr / pdf[channel].
+        let dist = t.min(t_surface);
+        if dist.is_finite() {
+            let tr = m.transmittance(dist);
+            let pdf = if scatter { tr * m.sigma_t } else { tr };
+            let p = pdf[channel];
+            self.beta *= if p > 0.0 { tr / p } else { Spectrum::ZERO };
+        }
+    }
+
+    #[inline]
+    fn real_scatter(&mut self, m: &Homogeneous) {
+        self.beta *= m.sigma_s();
+    }
+
+    #[inline]
+    fn medium_emitter_sampling(
+        &mut self,
+        scene: &Scene,
+        m: &Homogeneous,
+        p: Vec3,
+        wi: Vec3,
+        medium: Option<u32>,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        if !m.sample_emitters {
+            return Spectrum::ZERO;
+        }
+        let (emitted, ds) = sample_emitter(scene, RefPoint::Medium(p), medium, channel, sampler, stats);
+        if emitted == Spectrum::ZERO {
+            return Spectrum::ZERO;
+        }
+        let phase_val = m.phase.eval(wi, ds.d);
+        let w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { phase_val });
+        w * self.beta * phase_val * emitted
+    }
+
+    #[inline]
+    fn phase_sampled(&mut self, phase_weight: f32, phase_pdf: f32) -> bool {
+        if !(phase_pdf > 0.0) {
+            return false;
+        }
+        self.last_scatter_pdf = phase_pdf;
+        self.beta *= phase_weight;
+        true
+    }
+
+    #[inline]
+    fn emitter_hit(
+        &mut self,
+        scene: &Scene,
+        hit: &EmitterHit,
+        ray_d: Vec3,
+        count_direct: bool,
+        snee: Option<&SneeStage>,
+        channel: usize,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        // An emitter with zero radiance toward us is no hit (nor a suffix for SNEE to weigh).
+        if hit.le == Spectrum::ZERO {
+            return Spectrum::ZERO;
+        }
+        // The emitter-sampling density of this direction, computed at most once.
+        let p_light = std::cell::OnceCell::new();
+        let p_light = || *p_light.get_or_init(|| scene.pdf_emitter_direction(hit.from, &hit.ds));
+        let mut w = if count_direct { 1.0 } else { mis_weight(self.last_scatter_pdf, p_light()) };
+        if let Some(snee) = snee {
+            let light = || LightSample::hit(ray_d, hit.light_p, hit.ds.dist, p_light());
+            w = snee.weight(scene, ForwardTechnique::Bsdf, light, w, channel, stats);
+        }
+        self.beta * hit.le * w
+    }
+
+    #[inline]
+    fn surface_emitter_sampling(
+        &mut self,
+        scene: &Scene,
+        s: &SurfaceInteraction,
+        bsdf: &Bsdf,
+        medium: Option<u32>,
+        snee: Option<&SneeStage>,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        if scene.emitters.is_empty() {
+            return Spectrum::ZERO;
+        }
+        let (emitted, ds) = sample_emitter(scene, RefPoint::Surface(s), medium, channel, sampler, stats);
+        if emitted == Spectrum::ZERO {
+            return Spectrum::ZERO;
+        }
+        let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&BsdfContext::default(), s, s.to_local(ds.d));
+        let mut w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { bsdf_pdf });
+        if let Some(snee) = snee {
+            w = snee.weight(scene, ForwardTechnique::Nee, || LightSample::sampled(&ds), w, channel, stats);
+        }
+        self.beta * bsdf_val * w * emitted
+    }
+
+    #[inline]
+    fn accepts(&self, _: &BsdfSample) -> bool {
+        true
+    }
+
+    #[inline]
+    fn valid_after_failed_sample(&self, bsdf: &Bsdf, valid_ray: bool) -> bool {
+        valid_ray | (bsdf.flags() & !flags::NULL != 0)
+    }
+
+    #[inline]
+    fn bsdf_sampled(&mut self, bs: &BsdfSample, weight: Spectrum, non_null: bool) {
+        self.beta *= weight;
+        if non_null {
+            self.last_scatter_pdf = bs.pdf;
+        }
+    }
+
+    #[inline]
+    fn beta(&self) -> Spectrum {
+        self.beta
+    }
+}
+
+/// The volumetric path loop of `volpath`, `volpathmis` and `volpath_snee` (Mitsuba's volpath):
+/// Russian roulette, a free flight through the medium, at a real collision emitter sampling, SNEE
+/// and phase sampling; at a surface the emitter hit, emitter sampling and BSDF sampling. `weight`
+/// carries the estimator's weights, `snee` the SNEE stage (`volpath_snee` only).
+pub fn trace<W: PathWeight>(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    ray: Ray,
+    medium: Option<u32>,
+    stats: &mut LocalStats,
+    mut weight: W,
+    mut snee: Option<SneeStage>,
+) -> (Spectrum, bool) {
     let desc = &scene.integrator;
     let ctx = BsdfContext::default();
 
     // ---- Path state ----
     let mut ray = ray;
     let mut medium = medium;
-    let mut beta = Spectrum::ONE;
     let mut result = Spectrum::ZERO;
     let mut eta = 1.0f32;
     let mut depth = 0u32;
     let mut valid_ray = !desc.hide_emitters && scene.environment.is_some();
     let mut specular_chain = !desc.hide_emitters;
-    let PathSetup { max_depth, rr_depth, channel } = PathSetup::new(scene, sampler);
+    let setup = PathSetup::new(scene, sampler);
+    let PathSetup { max_depth, channel, .. } = setup;
     let mut last_scatter_p = ray.o;
-    let mut last_scatter_pdf = 1.0f32;
     // The surface hit along the current ray, when already traced.
     let mut si: Option<SurfaceInteraction> = None;
     let mut needs_intersection = true;
-    // ---- Connection techniques beside emitter and BSDF / phase sampling ----
-    let mut snee = snee.map(SneeStage::new);
     // Contributions outside SNEE's suffixes are dropped with transport = snee.
     let keep_all = snee.as_ref().is_none_or(|s| s.keeps_all());
 
     loop {
         // ---- Russian roulette and depth limit ----
-        let beta_max = beta.max_element();
-        if !(beta_max > 0.0) || !beta.is_finite() {
-            break;
-        }
-        let q = (beta_max * eta * eta).min(0.95);
-        let u_rr = sampler.next_1d();
-        if depth > rr_depth {
-            if u_rr >= q {
-                break;
-            }
-            beta /= q;
-        }
-        if depth >= max_depth {
+        if !weight.roulette(depth, &setup, eta, sampler) || depth >= max_depth {
             break;
         }
 
@@ -150,14 +382,7 @@ pub fn li_with(
             let m = &scene.media[mi as usize];
             let flight = free_flight(scene, m, &ray, channel, &mut si, &mut needs_intersection, sampler, stats);
             let t_surface = si.as_ref().map_or(f32::INFINITY, |s| s.t);
-            // Spectral transmittance ratio: Tr / pdf[channel].
-            let dist = flight.t.min(t_surface);
-            if dist.is_finite() {
-                let tr = m.transmittance(dist);
-                let pdf = if flight.scatter { tr * m.sigma_t } else { tr };
-                let p = pdf[channel];
-                beta *= if p > 0.0 { tr / p } else { Spectrum::ZERO };
-            }
+            weight.flight(m, flight.t, t_surface, flight.scatter, channel);
             if flight.scatter {
                 // Null-or-real decision (a homogeneous medium is all real: prob_scatter = 1).
                 let _ = sampler.next_1d();
@@ -167,35 +392,30 @@ pub fn li_with(
                 if depth >= max_depth {
                     break;
                 }
-                beta *= m.sigma_s();
+                weight.real_scatter(m);
                 let wi = -ray.d;
-
-                // ---- Emitter sampling at the medium vertex ----
                 valid_ray = true;
                 specular_chain = !m.sample_emitters;
-                if m.sample_emitters {
-                    let (emitted, ds) = sample_emitter(scene, RefPoint::Medium(p), medium, channel, sampler, stats);
-                    if emitted != Spectrum::ZERO && keep_all {
-                        let phase_val = m.phase.eval(wi, ds.d);
-                        let w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { phase_val });
-                        result += w * beta * phase_val * emitted;
-                    }
+
+                // ---- Emitter sampling at the medium vertex ----
+                let c = weight.medium_emitter_sampling(scene, m, p, wi, medium, channel, sampler, stats);
+                if keep_all {
+                    result += c;
                 }
 
                 // ---- Subdivision next-event estimation (volpath_snee) ----
                 if let Some(snee) = &mut snee {
+                    let beta = weight.beta();
                     result += snee.at_scatter(scene, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
                 }
 
                 // ---- Phase function sampling ----
                 let (wo, phase_weight, phase_pdf) = m.phase.sample(wi, sampler.next_2d());
-                if !(phase_pdf > 0.0) {
+                if !weight.phase_sampled(phase_weight, phase_pdf) {
                     break;
                 }
                 ray = Ray::new(p, wo);
                 needs_intersection = true;
-                last_scatter_pdf = phase_pdf;
-                beta *= phase_weight;
                 continue;
             }
             escaped_medium = true;
@@ -214,64 +434,52 @@ pub fn li_with(
         // ---- Emitters hit by the ray (area lights, or the environment on escape) ----
         let count_direct = depth == 0 || specular_chain;
         let hide = depth == 0 && desc.hide_emitters;
-        // The emitter hit, as (radiance, direction sample from the last scattering vertex, the point
-        // used for SNEE's light record). An area light with zero radiance toward us is no hit.
         let hit = match &si {
-            Some(s) if scene.shapes[s.shape as usize].emitter.is_some() => {
-                let le = scene.eval_area_emitter(s);
-                (le != Spectrum::ZERO).then(|| (le, scene.direction_sample_for_hit(last_scatter_p, s), s.p))
-            }
-            None => scene.environment.map(|env| {
-                (scene.eval_environment(ray.d), scene.environment_direction_sample(env, ray.d), last_scatter_p)
+            Some(s) if scene.shapes[s.shape as usize].emitter.is_some() => Some(EmitterHit {
+                le: scene.eval_area_emitter(s),
+                ds: scene.direction_sample_for_hit(last_scatter_p, s),
+                from: last_scatter_p,
+                light_p: s.p,
+            }),
+            None => scene.environment.map(|env| EmitterHit {
+                le: scene.eval_environment(ray.d),
+                ds: scene.environment_direction_sample(env, ray.d),
+                from: last_scatter_p,
+                light_p: last_scatter_p,
             }),
             _ => None,
         };
-        if let (false, Some((le, ds, light_p))) = (hide, hit) {
-            // The emitter-sampling density of this direction, computed at most once.
-            let p_light = std::cell::OnceCell::new();
-            let p_light = || *p_light.get_or_init(|| scene.pdf_emitter_direction(last_scatter_p, &ds));
-            let mut w = if count_direct { 1.0 } else { mis_weight(last_scatter_pdf, p_light()) };
-            if let Some(snee) = &snee {
-                let light = || LightSample::hit(ray.d, light_p, ds.dist, p_light());
-                w = snee.weight(scene, ForwardTechnique::Bsdf, light, w, channel, stats);
-            }
-            result += beta * le * w;
+        if let (false, Some(hit)) = (hide, hit) {
+            result += weight.emitter_hit(scene, &hit, ray.d, count_direct, snee.as_ref(), channel, stats);
         }
         let Some(s) = si else { break };
         let bsdf = scene.bsdf(&s);
 
         // ---- Emitter sampling at the surface ----
-        if bsdf.flags() & flags::SMOOTH != 0 && depth + 1 < max_depth && !scene.emitters.is_empty() {
-            let (emitted, ds) = sample_emitter(scene, RefPoint::Surface(&s), medium, channel, sampler, stats);
-            if emitted != Spectrum::ZERO {
-                let wo = s.to_local(ds.d);
-                let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &s, wo);
-                let mut w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { bsdf_pdf });
-                if let Some(snee) = &snee {
-                    w = snee.weight(scene, ForwardTechnique::Nee, || LightSample::sampled(&ds), w, channel, stats);
-                }
-                result += beta * bsdf_val * w * emitted;
-            }
+        if bsdf.flags() & flags::SMOOTH != 0 && depth + 1 < max_depth {
+            result +=
+                weight.surface_emitter_sampling(scene, &s, bsdf, medium, snee.as_ref(), channel, sampler, stats);
         }
 
         // ---- BSDF sampling ----
         let s1 = sampler.next_1d();
         let s2 = sampler.next_2d();
-        let Some((bs, weight)) = bsdf.sample(&ctx, &s, s1, s2) else {
-            valid_ray |= bsdf.flags() & !flags::NULL != 0;
+        let sample = bsdf.sample(&ctx, &s, s1, s2).filter(|(bs, _)| weight.accepts(bs));
+        let Some((bs, bsdf_weight)) = sample else {
+            valid_ray = weight.valid_after_failed_sample(bsdf, valid_ray);
             break;
         };
-        beta *= weight;
         eta *= bs.eta;
         let wo = s.to_world(bs.wo);
         ray = s.spawn_ray(wo);
+        let non_null = bs.sampled_type & flags::NULL == 0;
+        weight.bsdf_sampled(&bs, bsdf_weight, non_null);
         if let Some(snee) = &mut snee {
             snee.after_bsdf(scene, &s, &bs, wo);
         }
-        if bs.sampled_type & flags::NULL == 0 {
+        if non_null {
             depth += 1;
             last_scatter_p = s.p;
-            last_scatter_pdf = bs.pdf;
             valid_ray = true;
             if bs.sampled_type & flags::DELTA != 0 {
                 specular_chain = true;
