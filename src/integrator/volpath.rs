@@ -21,15 +21,15 @@
 //! as one more stage ([`SneeStage`]).
 
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
-use crate::bsdf::{Bsdf, BsdfSample};
-use crate::medium::Homogeneous;
-use crate::math::Vec3;
 use super::stats::LocalStats;
 use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, walk_segments, PathSetup, RefPoint};
 use crate::bsdf::{flags, BsdfContext};
+use crate::bsdf::{Bsdf, BsdfSample};
 use crate::color::Spectrum;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
+use crate::math::Vec3;
 use crate::math::{mis_weight, Ray};
+use crate::medium::Homogeneous;
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
 
@@ -457,8 +457,7 @@ pub fn trace<W: PathWeight>(
 
         // ---- Emitter sampling at the surface ----
         if bsdf.flags() & flags::SMOOTH != 0 && depth + 1 < max_depth {
-            result +=
-                weight.surface_emitter_sampling(scene, &s, bsdf, medium, snee.as_ref(), channel, sampler, stats);
+            result += weight.surface_emitter_sampling(scene, &s, bsdf, medium, snee.as_ref(), channel, sampler, stats);
         }
 
         // ---- BSDF sampling ----

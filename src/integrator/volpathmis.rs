@@ -31,6 +31,9 @@
 //!   hit can be weighted against light sampling; a specular chain (last non-null event delta, or
 //!   a medium that does not sample emitters) counts it at full MIS-over-channels weight.
 //!
+//! The path loop is `volpath`'s ([`trace`]); this file supplies the weights ([`SpectralMis`]) and
+//! the shadow-ray estimate that carries them ([`sample_emitter`]).
+//!
 //! Media are homogeneous: every collision is real (σn = 0), so no null-scattering events occur.
 //!
 //! Zero σt channels: every 0/0 or x/0 ratio is dropped, as in Mitsuba's `update_weights`, and a
@@ -40,9 +43,11 @@
 //! volpathmis loses ~40 % of the red channel on our test scene (σt,blue = 1e-30 gives the limit)
 //! and its volpath returns NaN; we do not reproduce that.
 
+use super::snee::SneeStage;
 use super::stats::LocalStats;
-use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, walk_segments, PathSetup, RefPoint};
-use crate::bsdf::{flags, BsdfContext};
+use super::volpath::{trace, EmitterHit, PathWeight};
+use super::walk::{shadow_ray, walk_segments, PathSetup, RefPoint};
+use crate::bsdf::{Bsdf, BsdfContext, BsdfSample};
 use crate::color::Spectrum;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::{Ray, Vec3};
@@ -212,169 +217,155 @@ pub fn li_with(
     stats: &mut LocalStats,
     roulette: RouletteMis,
 ) -> (Spectrum, bool) {
-    let desc = &scene.integrator;
-    let ctx = BsdfContext::default();
+    let weight = SpectralMis { p_over_f: POverF::ONE, p_over_f_nee: POverF::ONE, roulette };
+    trace(scene, sampler, ray, medium, stats, weight, None)
+}
 
-    // ---- Path state ----
-    let mut ray = ray;
-    let mut medium = medium;
-    let mut result = Spectrum::ZERO;
-    let mut eta = 1.0f32;
-    let mut depth = 0u32;
-    let mut valid_ray = !desc.hide_emitters && scene.environment.is_some();
-    let mut specular_chain = !desc.hide_emitters;
-    // Forward (BSDF / phase sampling) and light-sampling densities over throughput.
-    let mut p_over_f = POverF::ONE;
-    let mut p_over_f_nee = POverF::ONE;
-    let PathSetup { max_depth, rr_depth, channel } = PathSetup::new(scene, sampler);
-    let mut last_scatter_p = ray.o;
-    // The surface hit along the current ray, when already traced.
-    let mut si: Option<SurfaceInteraction> = None;
-    let mut needs_intersection = true;
+/// volpathmis's path weight: the forward (BSDF / phase sampling) and light-sampling densities over
+/// throughput, per hero channel.
+#[derive(Clone, Copy, Debug)]
+pub struct SpectralMis {
+    pub p_over_f: POverF,
+    /// Reset to `p_over_f` at every real scattering vertex (not at null interfaces).
+    pub p_over_f_nee: POverF,
+    pub roulette: RouletteMis,
+}
 
-    loop {
-        // ---- Russian roulette and depth limit ----
-        let q = (p_over_f.weight().max_element() * eta * eta).min(0.95);
+impl PathWeight for SpectralMis {
+    #[inline]
+    fn roulette(&mut self, depth: u32, setup: &PathSetup, eta: f32, sampler: &mut Sampler) -> bool {
+        let q = (self.p_over_f.weight().max_element() * eta * eta).min(0.95);
         let u_rr = sampler.next_1d();
-        if depth > rr_depth {
+        if depth > setup.rr_depth {
             if u_rr >= q {
-                break;
+                return false;
             }
-            p_over_f.update(Vec3::splat(q), Spectrum::ONE);
-            if roulette == RouletteMis::Unbiased {
-                p_over_f_nee.update(Vec3::splat(q), Spectrum::ONE);
+            self.p_over_f.update(Vec3::splat(q), Spectrum::ONE);
+            if self.roulette == RouletteMis::Unbiased {
+                self.p_over_f_nee.update(Vec3::splat(q), Spectrum::ONE);
             }
         }
-        if depth >= max_depth || p_over_f.weight() == Spectrum::ZERO {
-            break;
-        }
+        self.p_over_f.weight() != Spectrum::ZERO
+    }
 
-        // ---- Sample the medium along the ray (free flight in the hero channel) ----
-        let mut escaped_medium = false;
-        if let Some(mi) = medium {
-            let m = &scene.media[mi as usize];
-            let flight = free_flight(scene, m, &ray, channel, &mut si, &mut needs_intersection, sampler, stats);
-            let (t, scatter) = (flight.t, flight.scatter);
-            let t_surface = si.as_ref().map_or(f32::INFINITY, |s| s.t);
-            let (tr, pdf) = tr_and_pdf(m, t.min(t_surface), scatter);
-            p_over_f.update(pdf, tr);
-            p_over_f_nee.update(pdf, tr);
-            if scatter {
-                // Null-or-real decision (a homogeneous medium is all real: prob = σt/σmaj = 1).
-                let _ = sampler.next_1d();
-                let p = ray.at(t);
-                depth += 1;
-                last_scatter_p = p;
-                if depth >= max_depth {
-                    break;
-                }
-                specular_chain = !m.sample_emitters;
-                p_over_f.update(prob_real(m), m.sigma_s());
-                valid_ray = true;
-                let wi = -ray.d;
+    #[inline]
+    fn flight(&mut self, m: &Homogeneous, t: f32, t_surface: f32, scatter: bool, _channel: usize) {
+        let (tr, pdf) = tr_and_pdf(m, t.min(t_surface), scatter);
+        self.p_over_f.update(pdf, tr);
+        self.p_over_f_nee.update(pdf, tr);
+    }
 
-                // ---- Emitter sampling at the medium vertex ----
-                if m.sample_emitters {
-                    let (mut nee_end, mut uni_end, emitted, ds) =
-                        sample_emitter(scene, RefPoint::Medium(p), medium, &p_over_f, channel, sampler, stats);
-                    let phase_val = m.phase.eval(wi, ds.d);
-                    nee_end.update(Spectrum::ONE, Vec3::splat(phase_val));
-                    uni_end.update(Vec3::splat(if ds.delta { 0.0 } else { phase_val }), Vec3::splat(phase_val));
-                    result += nee_end.weight_with(&uni_end) * emitted;
-                }
-                // A real scattering vertex: light sampling restarts from here.
-                p_over_f_nee = p_over_f;
+    #[inline]
+    fn real_scatter(&mut self, m: &Homogeneous) {
+        // Null-or-real decision: a homogeneous medium is all real (prob = σt/σmaj = 1).
+        self.p_over_f.update(prob_real(m), m.sigma_s());
+    }
 
-                // ---- Phase function sampling ----
-                let (wo, phase_weight, phase_pdf) = m.phase.sample(wi, sampler.next_2d());
-                ray = Ray::new(p, wo);
-                needs_intersection = true;
-                let phase_val = Vec3::splat(phase_weight * phase_pdf);
-                p_over_f.update(Vec3::splat(phase_pdf), phase_val);
-                p_over_f_nee.update(Spectrum::ONE, phase_val);
-                continue;
-            }
-            escaped_medium = true;
-        }
-
-        // ---- Surface interaction ----
-        if needs_intersection && !escaped_medium {
-            stats.rays += 1;
-            si = scene.ray_intersect(&ray);
-        }
-        needs_intersection = true;
-
-        // ---- Emitters hit by the ray (area lights, or the environment on escape) ----
-        let count_direct = depth == 0 || specular_chain;
-        let hide = depth == 0 && desc.hide_emitters;
-        let hit = match (&si, scene.environment) {
-            (Some(s), _) if scene.shapes[s.shape as usize].emitter.is_some() => {
-                Some((scene.eval_area_emitter(s), scene.direction_sample_for_hit(last_scatter_p, s)))
-            }
-            (None, Some(env)) => Some((scene.eval_environment(ray.d), scene.environment_direction_sample(env, ray.d))),
-            _ => None,
-        };
-        if let (Some((le, ds)), false) = (hit, hide) {
-            let w = if count_direct {
-                p_over_f.weight()
-            } else {
-                let emitter_pdf = scene.pdf_emitter_direction(last_scatter_p, &ds);
-                p_over_f_nee.update(Vec3::splat(emitter_pdf), Spectrum::ONE);
-                p_over_f.weight_with(&p_over_f_nee)
-            };
-            result += w * le;
-        }
-        let Some(s) = si else { break };
-        let bsdf = scene.bsdf(&s);
-
-        // ---- Emitter sampling at the surface ----
-        if bsdf.flags() & flags::SMOOTH != 0 && depth + 1 < max_depth {
+    #[inline]
+    fn medium_emitter_sampling(
+        &mut self,
+        scene: &Scene,
+        m: &Homogeneous,
+        p: Vec3,
+        wi: Vec3,
+        medium: Option<u32>,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        let mut c = Spectrum::ZERO;
+        if m.sample_emitters {
             let (mut nee_end, mut uni_end, emitted, ds) =
-                sample_emitter(scene, RefPoint::Surface(&s), medium, &p_over_f, channel, sampler, stats);
-            if emitted != Spectrum::ZERO {
-                let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &s, s.to_local(ds.d));
-                nee_end.update(Spectrum::ONE, bsdf_val);
-                uni_end.update(Vec3::splat(if ds.delta { 0.0 } else { bsdf_pdf }), bsdf_val);
-                result += nee_end.weight_with(&uni_end) * emitted;
-            }
+                sample_emitter(scene, RefPoint::Medium(p), medium, &self.p_over_f, channel, sampler, stats);
+            let phase_val = m.phase.eval(wi, ds.d);
+            nee_end.update(Spectrum::ONE, Vec3::splat(phase_val));
+            uni_end.update(Vec3::splat(if ds.delta { 0.0 } else { phase_val }), Vec3::splat(phase_val));
+            c = nee_end.weight_with(&uni_end) * emitted;
         }
+        // A real scattering vertex: light sampling restarts from here.
+        self.p_over_f_nee = self.p_over_f;
+        c
+    }
 
-        // ---- BSDF sampling ----
-        let s1 = sampler.next_1d();
-        let s2 = sampler.next_2d();
-        let sample = bsdf.sample(&ctx, &s, s1, s2).filter(|(bs, _)| bs.pdf > 0.0);
-        let Some((bs, bsdf_weight)) = sample else {
-            // Mitsuba: an invalid BSDF sample still makes the ray valid.
-            valid_ray = true;
-            break;
+    #[inline]
+    fn phase_sampled(&mut self, phase_weight: f32, phase_pdf: f32) -> bool {
+        let phase_val = Vec3::splat(phase_weight * phase_pdf);
+        self.p_over_f.update(Vec3::splat(phase_pdf), phase_val);
+        self.p_over_f_nee.update(Spectrum::ONE, phase_val);
+        true
+    }
+
+    #[inline]
+    fn emitter_hit(
+        &mut self,
+        scene: &Scene,
+        hit: &EmitterHit,
+        _ray_d: Vec3,
+        count_direct: bool,
+        _snee: Option<&SneeStage>,
+        _channel: usize,
+        _stats: &mut LocalStats,
+    ) -> Spectrum {
+        let w = if count_direct {
+            self.p_over_f.weight()
+        } else {
+            let emitter_pdf = scene.pdf_emitter_direction(hit.from, &hit.ds);
+            self.p_over_f_nee.update(Vec3::splat(emitter_pdf), Spectrum::ONE);
+            self.p_over_f.weight_with(&self.p_over_f_nee)
         };
-        eta *= bs.eta;
-        let wo = s.to_world(bs.wo);
-        ray = s.spawn_ray(wo);
-        let non_null = bs.sampled_type & flags::NULL == 0;
-        let bsdf_val = bsdf_weight * bs.pdf;
+        w * hit.le
+    }
+
+    #[inline]
+    fn surface_emitter_sampling(
+        &mut self,
+        scene: &Scene,
+        s: &SurfaceInteraction,
+        bsdf: &Bsdf,
+        medium: Option<u32>,
+        _snee: Option<&SneeStage>,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        let (mut nee_end, mut uni_end, emitted, ds) =
+            sample_emitter(scene, RefPoint::Surface(s), medium, &self.p_over_f, channel, sampler, stats);
+        if emitted == Spectrum::ZERO {
+            return Spectrum::ZERO;
+        }
+        let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&BsdfContext::default(), s, s.to_local(ds.d));
+        nee_end.update(Spectrum::ONE, bsdf_val);
+        uni_end.update(Vec3::splat(if ds.delta { 0.0 } else { bsdf_pdf }), bsdf_val);
+        nee_end.weight_with(&uni_end) * emitted
+    }
+
+    #[inline]
+    fn accepts(&self, bs: &BsdfSample) -> bool {
+        bs.pdf > 0.0
+    }
+
+    #[inline]
+    fn valid_after_failed_sample(&self, _: &Bsdf, _: bool) -> bool {
+        // Mitsuba: an invalid BSDF sample still makes the ray valid.
+        true
+    }
+
+    #[inline]
+    fn bsdf_sampled(&mut self, bs: &BsdfSample, weight: Spectrum, non_null: bool) {
+        let bsdf_val = weight * bs.pdf;
         if non_null {
-            depth += 1;
-            last_scatter_p = s.p;
-            valid_ray = true;
-            if bs.sampled_type & flags::DELTA != 0 {
-                specular_chain = true;
-            }
             // A real scattering vertex: light sampling restarts from here (null interfaces
             // leave the light-sampling density untouched, as in Mitsuba).
-            p_over_f_nee = p_over_f;
-            p_over_f_nee.update(Spectrum::ONE, bsdf_val);
+            self.p_over_f_nee = self.p_over_f;
+            self.p_over_f_nee.update(Spectrum::ONE, bsdf_val);
         }
-        if bs.sampled_type & flags::SMOOTH != 0 {
-            specular_chain = false;
-        }
-        p_over_f.update(Vec3::splat(bs.pdf), bsdf_val);
-        if is_medium_transition(scene, &s) {
-            medium = target_medium(scene, &s, wo);
-        }
-        si = None;
+        self.p_over_f.update(Vec3::splat(bs.pdf), bsdf_val);
     }
-    (result, valid_ray)
+
+    #[inline]
+    fn beta(&self) -> Spectrum {
+        self.p_over_f.weight()
+    }
 }
 
 #[cfg(test)]
