@@ -8,7 +8,7 @@ use snee::math::{Mat4, Ray, Vec3};
 use snee::scene::build::build_scene;
 use snee::scene::xml::parse_str;
 use snee::shape::accel::Accel;
-use snee::shape::mesh::rectangle_data;
+use snee::shape::rectangle::rectangle_data;
 use snee::shape::{Disk, Geometry, Mesh, Shape, Sphere};
 use snee::testing::chi2::chi2_sphere;
 

@@ -1,11 +1,12 @@
 //! Emitters that are not attached to shapes: `directional`, `envmap`, `constant`, `point`, `spot`
-//! (area emitters live with their shapes and are built by the scene builder).
+//! (the `area` emitter, bound to a shape, is in `area.rs`).
 //!
 //! All follow Mitsuba 3.9's plugins of the same names: parameters, defaults, and the weights of
 //! `sample_direction` (radiance × geometry / pdf). Infinitely distant emitters (`directional`,
 //! `envmap`, `constant`) place their sample points beyond the scene's bounding sphere, which the
 //! builder passes once with [`Emitter::set_scene_bounds`].
 
+pub mod area;
 pub mod constant;
 pub mod directional;
 pub mod distribution;

@@ -14,8 +14,7 @@ use crate::math::{Aabb, Vec3};
 use crate::medium::Homogeneous;
 use crate::sensor::Sensor;
 use crate::shape::accel::Accel;
-use crate::shape::mesh::{cube_data, rectangle_data};
-use crate::shape::{mesh_data::MeshData, obj, ply, serialized, Disk, Geometry, Mesh, Shape, Sphere};
+use crate::shape::{Geometry, Shape};
 use crate::texture::Texture;
 use std::collections::HashMap;
 use std::path::Path;
@@ -26,8 +25,6 @@ pub fn load_scene(path: &Path, defines: &[(String, String)]) -> Result<Scene> {
     let parsed = super::xml::parse_file(path, defines)?;
     build_scene(&parsed)
 }
-
-pub const SUPPORTED_SHAPES: &str = "obj, ply, serialized, rectangle, cube, sphere, disk";
 
 struct Builder<'a> {
     resolver: &'a FileResolver,
@@ -246,61 +243,7 @@ impl Builder<'_> {
 
     fn shape(&mut self, obj: &Rc<ObjectDesc>) -> Result<()> {
         let props = &obj.props;
-        let to_world = props.transform("to_world")?;
-        if !to_world.is_finite() || to_world.determinant() == 0.0 {
-            return Err(props.error("to_world", "to_world is singular or not finite"));
-        }
-        let flip_normals = props.bool("flip_normals", false)?;
-        let mesh =
-            |data: MeshData, face_normals: bool| Geometry::Mesh(Mesh::new(data, &to_world, face_normals, flip_normals));
-        let geometry = match obj.plugin.as_str() {
-            "obj" | "ply" | "serialized" => {
-                let Some(name) = props.string_opt("filename")? else {
-                    return Err(Error::at(&obj.pos, format!("shape \"{}\" requires a \"filename\"", obj.plugin)));
-                };
-                let path = self.resolver.resolve_at(&name, &props.pos_of("filename"))?;
-                let face_normals = props.bool("face_normals", false)?;
-                let data = match obj.plugin.as_str() {
-                    "obj" => obj::load_obj_with(&path, props.bool("flip_tex_coords", true)?)?,
-                    "ply" => ply::load_ply_with(&path, props.bool("flip_tex_coords", false)?)?,
-                    _ => {
-                        let index = props.int("shape_index", 0)?;
-                        if index < 0 || index > u32::MAX as i64 {
-                            return Err(props.error("shape_index", "shape_index must be non-negative"));
-                        }
-                        serialized::load_serialized(&path, index as u32)?
-                    }
-                };
-                mesh(data, face_normals)
-            }
-            "rectangle" => mesh(rectangle_data(), false),
-            "cube" => mesh(cube_data(), false),
-            "sphere" => {
-                let center = props.point("center", Vec3::ZERO)?;
-                let radius = props.float("radius", 1.0)?;
-                if !(radius > 0.0 && radius.is_finite()) {
-                    return Err(props.error("radius", "sphere radius must be positive"));
-                }
-                let sx = to_world.transform_vector3(Vec3::X).length();
-                let sy = to_world.transform_vector3(Vec3::Y).length();
-                let sz = to_world.transform_vector3(Vec3::Z).length();
-                if (sx - sy).abs() > 1e-4 * sx || (sx - sz).abs() > 1e-4 * sx {
-                    return Err(props.error("to_world", "sphere: to_world must not contain a non-uniform scale"));
-                }
-                Geometry::Sphere(Sphere {
-                    center: to_world.transform_point3(center),
-                    radius: radius * sx,
-                    flip_normals,
-                })
-            }
-            "disk" => Geometry::Disk(Disk::new(to_world, flip_normals)),
-            other => {
-                return Err(Error::at(
-                    &obj.pos,
-                    format!("shape \"{}\" is not supported (supported: {})", other, SUPPORTED_SHAPES),
-                ))
-            }
-        };
+        let geometry = Geometry::from_desc(obj, self.resolver)?;
         let index = self.shapes.len() as u32;
         let interior = match props.object_named("interior", PluginKind::Medium)? {
             Some(m) => Some(self.medium(&m)?),
@@ -323,10 +266,7 @@ impl Builder<'_> {
                     format!("emitter \"{}\" cannot be attached to a shape (only \"area\" can)", e.plugin),
                 ));
             }
-            let ep = &e.props;
-            // Mitsuba's default radiance is a uniform 1 (untinted).
-            let radiance = Texture::from_arg(&ep.texture("radiance", Vec3::ONE)?, self.resolver)?;
-            ep.finish()?;
+            let radiance = crate::emitter::area::from_desc(&e, self.resolver)?;
             self.emitters.push(SceneEmitter::Area { shape: index, radiance });
             emitter = Some((self.emitters.len() - 1) as u32);
         }

@@ -3,7 +3,7 @@
 
 use crate::bsdf::Bsdf;
 use crate::color::Spectrum;
-use crate::emitter::Emitter;
+use crate::emitter::{area, Emitter};
 use crate::integrator::desc::Integrator;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
@@ -19,7 +19,7 @@ use crate::texture::Texture;
 #[derive(Clone, Debug)]
 #[allow(clippy::large_enum_variant)] // one per emitter, never per hit: no need to box
 pub enum SceneEmitter {
-    /// Mitsuba's `area` emitter: emits `radiance` from the front side of shape `shape`.
+    /// Mitsuba's `area` emitter (`emitter/area.rs`): emits `radiance` from the front side of shape `shape`.
     Area {
         shape: u32,
         radiance: Texture,
@@ -115,14 +115,7 @@ impl Scene {
         match &self.emitters[index] {
             SceneEmitter::Other(e) => e.sample_direction(ref_p, sample),
             SceneEmitter::Area { shape, radiance } => {
-                let ds = self.shapes[*shape as usize].sample_direction(ref_p, sample);
-                // Emission only from the front side (Mitsuba's area emitter is one-sided).
-                if ds.pdf > 0.0 && ds.d.dot(ds.n) < 0.0 {
-                    let w = radiance.eval(ds.uv) / ds.pdf;
-                    (ds, w)
-                } else {
-                    (DirectionSample { pdf: 0.0, ..ds }, Spectrum::ZERO)
-                }
+                area::sample_direction(radiance, &self.shapes[*shape as usize], ref_p, sample)
             }
         }
     }
@@ -132,12 +125,7 @@ impl Scene {
         let sel = self.emitter_selection_pdf();
         match &self.emitters[ds.emitter as usize] {
             SceneEmitter::Other(e) => e.pdf_direction(ref_p, ds) * sel,
-            SceneEmitter::Area { shape, .. } => {
-                if ds.d.dot(ds.n) >= 0.0 {
-                    return 0.0;
-                }
-                self.shapes[*shape as usize].pdf_direction(ref_p, ds) * sel
-            }
+            SceneEmitter::Area { shape, .. } => area::pdf_direction(&self.shapes[*shape as usize], ref_p, ds) * sel,
         }
     }
 
@@ -145,7 +133,7 @@ impl Scene {
     pub fn eval_area_emitter(&self, si: &SurfaceInteraction) -> Spectrum {
         let Some(e) = self.shapes[si.shape as usize].emitter else { return Spectrum::ZERO };
         match &self.emitters[e as usize] {
-            SceneEmitter::Area { radiance, .. } if si.wi.z > 0.0 => radiance.eval(si.uv),
+            SceneEmitter::Area { radiance, .. } => area::eval(radiance, si),
             _ => Spectrum::ZERO,
         }
     }

@@ -5,8 +5,12 @@
 //! recomputed by angle weighting as Mitsuba's `Mesh::recompute_vertex_normals` does.
 
 use super::mesh_data::MeshData;
+use super::{obj, ply, serialized, Geometry};
 use crate::interaction::{PositionSample, SurfaceInteraction};
 use crate::math::{warp, Aabb, Frame, Mat4, Vec2, Vec3};
+use crate::scene::desc::ObjectDesc;
+use crate::scene::resolver::FileResolver;
+use crate::scene::{Error, Result};
 
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -154,61 +158,24 @@ pub fn recompute_vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec
     normals
 }
 
-/// Mitsuba's `rectangle`: [-1,1]² in the local XY plane, normal +Z, uv = ((x+1)/2, (y+1)/2).
-pub fn rectangle_data() -> MeshData {
-    MeshData {
-        positions: vec![
-            Vec3::new(-1.0, -1.0, 0.0),
-            Vec3::new(1.0, -1.0, 0.0),
-            Vec3::new(-1.0, 1.0, 0.0),
-            Vec3::new(1.0, 1.0, 0.0),
-        ],
-        normals: vec![Vec3::Z; 4],
-        uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0)],
-        indices: vec![[1, 2, 0], [1, 3, 2]],
-    }
-}
-
-/// Mitsuba's `cube`: [-1,1]³, 24 vertices with per-face normals and uvs (data read from Mitsuba 3.9).
-pub fn cube_data() -> MeshData {
-    const P: [[f32; 3]; 24] = [
-        [1., -1., -1.],
-        [1., -1., 1.],
-        [-1., -1., 1.],
-        [-1., -1., -1.],
-        [1., 1., -1.],
-        [-1., 1., -1.],
-        [-1., 1., 1.],
-        [1., 1., 1.],
-        [1., -1., -1.],
-        [1., 1., -1.],
-        [1., 1., 1.],
-        [1., -1., 1.],
-        [1., -1., 1.],
-        [1., 1., 1.],
-        [-1., 1., 1.],
-        [-1., -1., 1.],
-        [-1., -1., 1.],
-        [-1., 1., 1.],
-        [-1., 1., -1.],
-        [-1., -1., -1.],
-        [1., 1., -1.],
-        [1., -1., -1.],
-        [-1., -1., -1.],
-        [-1., 1., -1.],
-    ];
-    const N: [[f32; 3]; 6] = [[0., -1., 0.], [0., 1., 0.], [1., 0., 0.], [0., 0., 1.], [-1., 0., 0.], [0., 0., -1.]];
-    const UV: [[f32; 2]; 4] = [[0., 1.], [1., 1.], [1., 0.], [0., 0.]];
-    let mut d = MeshData::default();
-    for (i, p) in P.iter().enumerate() {
-        d.positions.push(Vec3::from_array(*p));
-        d.normals.push(Vec3::from_array(N[i / 4]));
-        d.uvs.push(Vec2::from_array(UV[i % 4]));
-    }
-    for f in 0..6u32 {
-        let b = 4 * f;
-        d.indices.push([b, b + 1, b + 2]);
-        d.indices.push([b + 3, b, b + 2]);
-    }
-    d
+/// A mesh loaded from a file (`obj`, `ply`, `serialized`): the `filename` and `face_normals`
+/// parameters shared by the three, and the format's own (read by its loader module).
+pub fn from_file_props(
+    obj: &ObjectDesc,
+    resolver: &FileResolver,
+    to_world: &Mat4,
+    flip_normals: bool,
+) -> Result<Geometry> {
+    let props = &obj.props;
+    let Some(name) = props.string_opt("filename")? else {
+        return Err(Error::at(&obj.pos, format!("shape \"{}\" requires a \"filename\"", obj.plugin)));
+    };
+    let path = resolver.resolve_at(&name, &props.pos_of("filename"))?;
+    let face_normals = props.bool("face_normals", false)?;
+    let data = match obj.plugin.as_str() {
+        "obj" => obj::from_props(props, &path)?,
+        "ply" => ply::from_props(props, &path)?,
+        _ => serialized::from_props(props, &path)?,
+    };
+    Ok(Geometry::Mesh(Mesh::new(data, to_world, face_normals, flip_normals)))
 }

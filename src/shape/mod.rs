@@ -3,16 +3,21 @@
 //! interior / exterior media.
 
 pub mod accel;
+pub mod cube;
 pub mod disk;
 pub mod mesh;
 pub mod mesh_data;
 pub mod obj;
 pub mod ply;
+pub mod rectangle;
 pub mod serialized;
 pub mod sphere;
 
 use crate::interaction::{DirectionSample, PositionSample, SurfaceInteraction};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
+use crate::scene::desc::ObjectDesc;
+use crate::scene::resolver::FileResolver;
+use crate::scene::{Error, Result};
 pub use disk::Disk;
 pub use mesh::Mesh;
 pub use sphere::Sphere;
@@ -22,6 +27,36 @@ pub enum Geometry {
     Mesh(Mesh),
     Sphere(Sphere),
     Disk(Disk),
+}
+
+/// The shape types `Geometry::from_desc` reads.
+pub const SUPPORTED_SHAPES: &str = "obj, ply, serialized, rectangle, cube, sphere, disk";
+
+impl Geometry {
+    /// The geometry of a `<shape>`: the parameters every shape has (`to_world`, `flip_normals`),
+    /// then the plugin's own, read by its file (`rectangle.rs`, `cube.rs`, `sphere.rs`, ...).
+    /// The BSDF, emitter and media of the shape are the scene builder's.
+    pub fn from_desc(obj: &ObjectDesc, resolver: &FileResolver) -> Result<Geometry> {
+        let props = &obj.props;
+        let to_world = props.transform("to_world")?;
+        if !to_world.is_finite() || to_world.determinant() == 0.0 {
+            return Err(props.error("to_world", "to_world is singular or not finite"));
+        }
+        let flip_normals = props.bool("flip_normals", false)?;
+        Ok(match obj.plugin.as_str() {
+            "obj" | "ply" | "serialized" => mesh::from_file_props(obj, resolver, &to_world, flip_normals)?,
+            "rectangle" => rectangle::from_props(&to_world, flip_normals),
+            "cube" => cube::from_props(&to_world, flip_normals),
+            "sphere" => Geometry::Sphere(Sphere::from_props(props, &to_world, flip_normals)?),
+            "disk" => Geometry::Disk(Disk::new(to_world, flip_normals)),
+            other => {
+                return Err(Error::at(
+                    &obj.pos,
+                    format!("shape \"{}\" is not supported (supported: {})", other, SUPPORTED_SHAPES),
+                ))
+            }
+        })
+    }
 }
 
 /// A shape in the scene with indices into the scene's BSDF, emitter and medium arrays.

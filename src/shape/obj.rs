@@ -290,6 +290,11 @@ impl Hasher for FxHasher {
     }
 }
 
+/// The `obj` shape's own parameter: `flip_tex_coords` (default true, as Mitsuba).
+pub fn from_props(props: &crate::scene::desc::Props, path: &Path) -> Result<MeshData> {
+    load_obj_with(path, props.bool("flip_tex_coords", true)?)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

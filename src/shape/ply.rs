@@ -874,6 +874,11 @@ fn read_faces<R: Body>(
     Ok(())
 }
 
+/// The `ply` shape's own parameter: `flip_tex_coords` (default false, as Mitsuba).
+pub fn from_props(props: &crate::scene::desc::Props, path: &Path) -> Result<MeshData> {
+    load_ply_with(path, props.bool("flip_tex_coords", false)?)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

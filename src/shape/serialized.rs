@@ -274,3 +274,12 @@ impl Stream<'_> {
         Ok(mesh)
     }
 }
+
+/// The `serialized` shape's own parameter: `shape_index` (default 0).
+pub fn from_props(props: &crate::scene::desc::Props, path: &Path) -> Result<MeshData> {
+    let index = props.int("shape_index", 0)?;
+    if index < 0 || index > u32::MAX as i64 {
+        return Err(props.error("shape_index", "shape_index must be non-negative"));
+    }
+    load_serialized(path, index as u32)
+}

@@ -154,3 +154,26 @@ pub fn area_pdf_to_solid_angle(pdf_area: f32, dist: f32, d: Vec3, n: Vec3) -> f3
         0.0
     }
 }
+
+impl Sphere {
+    /// The `sphere` shape's own parameters: `center` (0, 0, 0) and `radius` (1), placed by
+    /// `to_world` (which must not scale non-uniformly).
+    pub fn from_props(
+        props: &crate::scene::desc::Props,
+        to_world: &crate::math::Mat4,
+        flip_normals: bool,
+    ) -> crate::scene::Result<Sphere> {
+        let center = props.point("center", Vec3::ZERO)?;
+        let radius = props.float("radius", 1.0)?;
+        if !(radius > 0.0 && radius.is_finite()) {
+            return Err(props.error("radius", "sphere radius must be positive"));
+        }
+        let sx = to_world.transform_vector3(Vec3::X).length();
+        let sy = to_world.transform_vector3(Vec3::Y).length();
+        let sz = to_world.transform_vector3(Vec3::Z).length();
+        if (sx - sy).abs() > 1e-4 * sx || (sx - sz).abs() > 1e-4 * sx {
+            return Err(props.error("to_world", "sphere: to_world must not contain a non-uniform scale"));
+        }
+        Ok(Sphere { center: to_world.transform_point3(center), radius: radius * sx, flip_normals })
+    }
+}
