@@ -358,7 +358,7 @@ fn chi2_plastic_and_mask() {
 /// `plastic` go to the mirror direction.
 #[test]
 fn sample_weight_is_eval_over_pdf() {
-    let bsdfs = vec![
+    let bsdfs = [
         rough_conductor(true, 0.2, 0.2, true),
         rough_conductor(false, 0.1, 0.4, true),
         rough_conductor(true, 0.3, 0.1, false),

@@ -177,7 +177,7 @@ impl Plastic {
 
     pub fn eval_pdf(&self, ctx: &BsdfContext, si: &SurfaceInteraction, wo: Vec3) -> (Spectrum, f32) {
         let (cos_theta_i, cos_theta_o) = (si.wi.z, wo.z);
-        if !(cos_theta_i > 0.0 && cos_theta_o > 0.0) || !ctx.is_enabled(flags::DIFFUSE_REFLECTION, 1) {
+        if !(cos_theta_i > 0.0 && cos_theta_o > 0.0 && ctx.is_enabled(flags::DIFFUSE_REFLECTION, 1)) {
             return (Spectrum::ZERO, 0.0);
         }
         let f_i = fresnel(cos_theta_i, self.eta).0;

@@ -118,9 +118,8 @@ impl RoughConductor {
         let (cos_theta_i, cos_theta_o) = (wi.z, wo.z);
         let h = (wo + wi).normalize();
         // Micro- and macro-surface must agree on the side (as smith_g1 checks).
-        if !(cos_theta_i > 0.0 && cos_theta_o > 0.0 && wi.dot(h) > 0.0 && wo.dot(h) > 0.0)
-            || !ctx.is_enabled(flags::GLOSSY_REFLECTION, 0)
-        {
+        let valid = cos_theta_i > 0.0 && cos_theta_o > 0.0 && wi.dot(h) > 0.0 && wo.dot(h) > 0.0;
+        if !(valid && ctx.is_enabled(flags::GLOSSY_REFLECTION, 0)) {
             return (Spectrum::ZERO, 0.0);
         }
         let distr = self.distr(si);
@@ -141,9 +140,8 @@ impl RoughConductor {
     pub fn pdf(&self, ctx: &BsdfContext, si: &SurfaceInteraction, wo: Vec3) -> f32 {
         let wi = si.wi;
         let h = (wo + wi).normalize();
-        if !(wi.z > 0.0 && wo.z > 0.0 && wi.dot(h) > 0.0 && wo.dot(h) > 0.0)
-            || !ctx.is_enabled(flags::GLOSSY_REFLECTION, 0)
-        {
+        let valid = wi.z > 0.0 && wo.z > 0.0 && wi.dot(h) > 0.0 && wo.dot(h) > 0.0;
+        if !(valid && ctx.is_enabled(flags::GLOSSY_REFLECTION, 0)) {
             return 0.0;
         }
         let distr = self.distr(si);
