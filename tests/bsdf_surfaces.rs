@@ -394,3 +394,50 @@ fn sample_weight_is_eval_over_pdf() {
         assert!(n > 100 || i == 6, "bsdf {i}: only {n} smooth samples");
     }
 }
+
+/// Bad parameters are errors (never panics), as in Mitsuba; defaults are Mitsuba's.
+#[test]
+fn parameters_and_errors() {
+    let err = |plugin: &str, props: Vec<(&str, Value)>| -> String {
+        let props = props.into_iter().map(|(n, v)| (n.to_string(), v)).collect();
+        match Bsdf::from_desc(&desc(plugin, props), &FileResolver::default()) {
+            Ok(b) => panic!("{plugin}: expected an error, got {b:?}"),
+            Err(e) => e.msg,
+        }
+    };
+    let s = |v: &str| Value::String(v.into());
+    assert!(err("conductor", vec![("material", s("Unobtainium"))]).contains("unknown conductor material"));
+    assert!(err("conductor", vec![("material", s("Au")), ("eta", Value::Float(0.2))]).contains("not both"));
+    assert!(err("roughconductor", vec![("alpha_u", Value::Float(0.2))]).contains("both"));
+    assert!(err("roughconductor", vec![("distribution", s("phong"))]).contains("invalid distribution"));
+    assert!(err("roughplastic", vec![("alpha_u", Value::Float(0.1)), ("alpha_v", Value::Float(0.2))])
+        .contains("anisotropic"));
+    assert!(
+        err("roughplastic", vec![("int_ior", Value::Float(1.3)), ("ext_ior", Value::Float(1.3))]).contains("differ")
+    );
+    assert!(err("plastic", vec![("int_ior", Value::Float(-1.0))]).contains("positive"));
+    assert!(err("plastic", vec![("roughness", Value::Float(0.1))]).contains("roughness"));
+    assert!(err("mask", vec![("opacity", Value::Float(0.5))]).contains("nested BSDF is required"));
+    let two = vec![
+        ("a", Value::Object(Rc::new(desc("diffuse", vec![])))),
+        ("b", Value::Object(Rc::new(desc("diffuse", vec![])))),
+    ];
+    assert!(err("mask", two).contains("more than one"));
+
+    // Defaults: conductor = perfect mirror; plastic and roughplastic = polypropylene (1.49) over air.
+    let si = si_with_wi(sph(30.0, 0.0));
+    let (_, w) = load("conductor", vec![]).sample(&BsdfContext::default(), &si, 0.5, Vec2::splat(0.5)).unwrap();
+    assert!((w - Spectrum::ONE).abs().max_element() < 1e-6);
+    match load("roughplastic", vec![]) {
+        Bsdf::RoughPlastic(p) => {
+            assert!((p.eta - 1.49 / 1.000277).abs() < 1e-6 && p.alpha == 0.1 && p.sample_visible);
+            assert_eq!(p.distribution, snee::bsdf::microfacet::MicrofacetType::Beckmann);
+        }
+        other => panic!("{other:?}"),
+    }
+    // An <rgb> index of refraction may exceed 1 (unlike reflectances).
+    load(
+        "conductor",
+        vec![("eta", Value::Rgb(DVec3::new(0.2, 0.9, 1.1))), ("k", Value::Rgb(DVec3::new(3.9, 2.4, 2.1)))],
+    );
+}
