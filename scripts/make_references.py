@@ -83,6 +83,9 @@ DEFAULT_SPP = {
     "media_thin": 16384,
     "media_spot": 16384,
     "media_camera_inside": 16384,
+    "surfaces_metals": 8192,
+    "surfaces_plastics": 8192,
+    "surfaces_translucent": 8192,
 }
 FALLBACK_SPP = 4096
 MAX_SAMPLES_PER_PASS = 1 << 22

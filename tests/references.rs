@@ -371,3 +371,18 @@ fn media_spot() {
 fn media_camera_inside() {
     check_scene("media_camera_inside", 16, true);
 }
+
+// Surface BSDF scenes (conductor, roughconductor, plastic, roughplastic, mask): block and per-pixel
+// tests (they pass with seeds 5000, 9000 and the default).
+#[test]
+fn surfaces_metals() {
+    check_scene("surfaces_metals", 32, true);
+}
+#[test]
+fn surfaces_plastics() {
+    check_scene("surfaces_plastics", 32, true);
+}
+#[test]
+fn surfaces_translucent() {
+    check_scene("surfaces_translucent", 128, true);
+}

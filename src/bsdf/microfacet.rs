@@ -6,6 +6,8 @@
 //! to at least 1e-4 like Mitsuba does.
 
 use crate::math::{safe_sqrt, warp, Vec2, Vec3, PI};
+use crate::scene::desc::Props;
+use crate::scene::Result;
 
 /// The normal distribution function.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -14,6 +16,21 @@ pub enum MicrofacetType {
     Beckmann,
     /// GGX / Trowbridge-Reitz, long-tailed.
     Ggx,
+}
+
+/// The `distribution` parameter: `beckmann` (default) or `ggx`, case-insensitive as in Mitsuba.
+pub fn read_distribution(props: &Props) -> Result<MicrofacetType> {
+    match props.string_opt("distribution")? {
+        None => Ok(MicrofacetType::Beckmann),
+        Some(s) => {
+            match s.to_ascii_lowercase().as_str() {
+                "beckmann" => Ok(MicrofacetType::Beckmann),
+                "ggx" => Ok(MicrofacetType::Ggx),
+                _ => Err(props
+                    .error("distribution", format!("invalid distribution \"{}\", must be \"beckmann\" or \"ggx\"", s))),
+            }
+        }
+    }
 }
 
 /// A microfacet distribution with (possibly anisotropic) roughness.

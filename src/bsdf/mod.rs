@@ -13,20 +13,32 @@
 //! [`BsdfContext::component`] restricts sampling/evaluation to one of them (then it is sampled with
 //! probability 1 and the weight carries the Fresnel factor).
 //!
-//! Supported plugins: `diffuse`, `dielectric`, `thindielectric`, `roughdielectric`, `null`, `twosided`.
+//! Supported plugins: `diffuse`, `dielectric`, `thindielectric`, `roughdielectric`, `null`, `twosided`,
+//! `conductor`, `roughconductor`, `plastic`, `roughplastic`, `mask`.
 
+pub mod conductor;
+pub mod conductor_materials;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+pub mod mask;
 pub mod microfacet;
 pub mod null;
+pub mod plastic;
+pub mod rough_conductor;
 pub mod rough_dielectric;
+pub mod rough_plastic;
 pub mod thin_dielectric;
 pub mod twosided;
 
+pub use conductor::Conductor;
 pub use dielectric::Dielectric;
 pub use diffuse::Diffuse;
+pub use mask::Mask;
+pub use plastic::Plastic;
+pub use rough_conductor::RoughConductor;
 pub use rough_dielectric::RoughDielectric;
+pub use rough_plastic::RoughPlastic;
 pub use thin_dielectric::ThinDielectric;
 
 use crate::color::Spectrum;
@@ -139,11 +151,27 @@ pub enum Bsdf {
     Null,
     /// `twosided`: front and back models (the same model twice when one was given).
     TwoSided(Box<Bsdf>, Box<Bsdf>),
+    Conductor(Conductor),
+    RoughConductor(RoughConductor),
+    Plastic(Plastic),
+    RoughPlastic(RoughPlastic),
+    Mask(Mask),
 }
 
 /// The plugin names [`Bsdf::from_desc`] accepts.
-pub const SUPPORTED_PLUGINS: &[&str] =
-    &["diffuse", "dielectric", "thindielectric", "roughdielectric", "null", "twosided"];
+pub const SUPPORTED_PLUGINS: &[&str] = &[
+    "diffuse",
+    "dielectric",
+    "thindielectric",
+    "roughdielectric",
+    "null",
+    "twosided",
+    "conductor",
+    "roughconductor",
+    "plastic",
+    "roughplastic",
+    "mask",
+];
 
 impl Bsdf {
     /// From a `<bsdf>` object; unknown plugin → error at its position listing the supported ones; calls `props.finish()`.
@@ -156,6 +184,11 @@ impl Bsdf {
             "roughdielectric" => Bsdf::RoughDielectric(RoughDielectric::from_props(props, resolver)?),
             "null" => Bsdf::Null,
             "twosided" => twosided::from_props(props, resolver)?,
+            "conductor" => Bsdf::Conductor(Conductor::from_props(props, resolver)?),
+            "roughconductor" => Bsdf::RoughConductor(RoughConductor::from_props(props, resolver)?),
+            "plastic" => Bsdf::Plastic(Plastic::from_props(props, resolver)?),
+            "roughplastic" => Bsdf::RoughPlastic(RoughPlastic::from_props(props, resolver)?),
+            "mask" => Bsdf::Mask(Mask::from_props(props, resolver)?),
             other => {
                 return Err(Error::at(
                     &obj.pos,
@@ -173,6 +206,9 @@ impl Bsdf {
             Bsdf::Diffuse(_) | Bsdf::Null => 1,
             Bsdf::Dielectric(_) | Bsdf::ThinDielectric(_) | Bsdf::RoughDielectric(_) => 2,
             Bsdf::TwoSided(front, back) => front.component_count() + back.component_count(),
+            Bsdf::Conductor(_) | Bsdf::RoughConductor(_) => 1,
+            Bsdf::Plastic(_) | Bsdf::RoughPlastic(_) => 2,
+            Bsdf::Mask(b) => b.component_count(),
         }
     }
 
@@ -185,6 +221,11 @@ impl Bsdf {
             Bsdf::RoughDielectric(b) => b.component_flags(i),
             Bsdf::Null => null::component_flags(i),
             Bsdf::TwoSided(front, back) => twosided::component_flags(front, back, i),
+            Bsdf::Conductor(_) => conductor::component_flags(i),
+            Bsdf::RoughConductor(b) => b.component_flags(i),
+            Bsdf::Plastic(_) => plastic::component_flags(i),
+            Bsdf::RoughPlastic(_) => rough_plastic::component_flags(i),
+            Bsdf::Mask(b) => b.component_flags(i),
         }
     }
 
@@ -215,6 +256,11 @@ impl Bsdf {
             Bsdf::RoughDielectric(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::Null => null::sample(ctx, si),
             Bsdf::TwoSided(front, back) => twosided::sample(front, back, ctx, si, sample1, sample2),
+            Bsdf::Conductor(b) => b.sample(ctx, si, sample1, sample2),
+            Bsdf::RoughConductor(b) => b.sample(ctx, si, sample1, sample2),
+            Bsdf::Plastic(b) => b.sample(ctx, si, sample1, sample2),
+            Bsdf::RoughPlastic(b) => b.sample(ctx, si, sample1, sample2),
+            Bsdf::Mask(b) => b.sample(ctx, si, sample1, sample2),
         }?;
         (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
     }
@@ -226,6 +272,11 @@ impl Bsdf {
             Bsdf::RoughDielectric(b) => b.eval_pdf(ctx, si, wo).0,
             Bsdf::Dielectric(_) | Bsdf::ThinDielectric(_) | Bsdf::Null => Spectrum::ZERO,
             Bsdf::TwoSided(front, back) => twosided::eval_pdf(front, back, ctx, si, wo).0,
+            Bsdf::Conductor(_) => Spectrum::ZERO,
+            Bsdf::RoughConductor(b) => b.eval_pdf(ctx, si, wo).0,
+            Bsdf::Plastic(b) => b.eval_pdf(ctx, si, wo).0,
+            Bsdf::RoughPlastic(b) => b.eval_pdf(ctx, si, wo).0,
+            Bsdf::Mask(b) => b.eval_pdf(ctx, si, wo).0,
         }
     }
 
@@ -236,6 +287,11 @@ impl Bsdf {
             Bsdf::RoughDielectric(b) => b.pdf(ctx, si, wo),
             Bsdf::Dielectric(_) | Bsdf::ThinDielectric(_) | Bsdf::Null => 0.0,
             Bsdf::TwoSided(front, back) => twosided::eval_pdf(front, back, ctx, si, wo).1,
+            Bsdf::Conductor(_) => 0.0,
+            Bsdf::RoughConductor(b) => b.pdf(ctx, si, wo),
+            Bsdf::Plastic(b) => b.eval_pdf(ctx, si, wo).1,
+            Bsdf::RoughPlastic(b) => b.eval_pdf(ctx, si, wo).1,
+            Bsdf::Mask(b) => b.eval_pdf(ctx, si, wo).1,
         }
     }
 
@@ -246,6 +302,11 @@ impl Bsdf {
             Bsdf::RoughDielectric(b) => b.eval_pdf(ctx, si, wo),
             Bsdf::Dielectric(_) | Bsdf::ThinDielectric(_) | Bsdf::Null => (Spectrum::ZERO, 0.0),
             Bsdf::TwoSided(front, back) => twosided::eval_pdf(front, back, ctx, si, wo),
+            Bsdf::Conductor(_) => (Spectrum::ZERO, 0.0),
+            Bsdf::RoughConductor(b) => b.eval_pdf(ctx, si, wo),
+            Bsdf::Plastic(b) => b.eval_pdf(ctx, si, wo),
+            Bsdf::RoughPlastic(b) => b.eval_pdf(ctx, si, wo),
+            Bsdf::Mask(b) => b.eval_pdf(ctx, si, wo),
         }
     }
 
@@ -254,6 +315,7 @@ impl Bsdf {
         match self {
             Bsdf::Null => Spectrum::ONE,
             Bsdf::ThinDielectric(b) => b.eval_null_transmission(si),
+            Bsdf::Mask(b) => b.eval_null_transmission(si),
             // Mitsuba's twosided does not forward this (it only nests non-transmissive models by default).
             _ => Spectrum::ZERO,
         }
@@ -296,6 +358,17 @@ pub(crate) fn times_texture(value: Spectrum, tex: &Option<Texture>, si: &Surface
     match tex {
         Some(t) => value * t.eval(si.uv),
         None => value,
+    }
+}
+
+/// A texture read as one number, as Mitsuba's `eval_1` does in RGB mode: a constant gives the mean
+/// of its channels, a bitmap (and here any other texture) the luminance of its colour.
+#[inline]
+pub(crate) fn eval_1(tex: &Texture, uv: Vec2) -> f32 {
+    match tex {
+        Texture::Const(c) if c.x == c.y && c.y == c.z => c.x,
+        Texture::Const(c) => (c.x + c.y + c.z) / 3.0,
+        t => crate::color::luminance(t.eval(uv)),
     }
 }
 

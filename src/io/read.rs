@@ -7,6 +7,11 @@
 //! - PNG: 8 or 16 bit, grey, grey+alpha, RGB, RGBA (palette images are expanded to RGB(A)).
 //!   With `srgb_to_linear` the colour channels (not alpha) go through the sRGB transfer curve,
 //!   as Mitsuba does for 8/16-bit images unless a texture asks for `raw` data.
+//! - JPEG, BMP, TGA: 8-bit data, treated like PNG (sRGB-encoded unless `raw`).
+//! - Radiance RGBE (`.hdr`, `.rgbe`) and PFM (`PF` colour / `Pf` grey, either byte order, rows
+//!   stored bottom-up): linear floats, never converted (Mitsuba treats float formats as linear).
+//!
+//! Formats are recognised by their first bytes (TGA, which has no signature, by the `.tga` extension).
 //!
 //! Every failure is an [`Error::in_file`] naming the file.
 
@@ -91,17 +96,30 @@ impl Bitmap {
     }
 }
 
-/// Read an OpenEXR or PNG file (detected from its first bytes, not its extension).
-/// `srgb_to_linear` linearises the colour channels of 8/16-bit PNG data; EXR data is linear already.
+/// Read an image (OpenEXR, PNG, JPEG, BMP, TGA, RGBE or PFM; detected from its first bytes).
+/// `srgb_to_linear` linearises the colour channels of 8/16-bit data; float formats are linear already.
 pub fn read_image(path: &Path, srgb_to_linear: bool) -> Result<Bitmap> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| Error::in_file(&file, format!("cannot read image: {e}")))?;
     let bitmap = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
         read_exr(&bytes, &file)?
     } else if bytes.starts_with(&[0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a]) {
-        read_png(&bytes, &file, srgb_to_linear)?
+        read_ldr(&bytes, &file, srgb_to_linear, image::ImageFormat::Png)?
+    } else if bytes.starts_with(&[0xff, 0xd8, 0xff]) {
+        read_ldr(&bytes, &file, srgb_to_linear, image::ImageFormat::Jpeg)?
+    } else if bytes.starts_with(b"BM") {
+        read_ldr(&bytes, &file, srgb_to_linear, image::ImageFormat::Bmp)?
+    } else if bytes.starts_with(b"#?") {
+        read_rgbe(&bytes, &file)?
+    } else if bytes.starts_with(b"PF") || bytes.starts_with(b"Pf") {
+        read_pfm(&bytes, &file)?
+    } else if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("tga")) {
+        read_ldr(&bytes, &file, srgb_to_linear, image::ImageFormat::Tga)?
     } else {
-        return Err(Error::in_file(&file, "unsupported image format (expected OpenEXR or PNG)"));
+        return Err(Error::in_file(
+            &file,
+            "unsupported image format (expected OpenEXR, PNG, JPEG, BMP, TGA, RGBE/HDR or PFM)",
+        ));
     };
     if bitmap.width == 0 || bitmap.height == 0 || bitmap.channels.is_empty() {
         return Err(Error::in_file(&file, "image is empty"));
@@ -149,10 +167,12 @@ fn read_exr(bytes: &[u8], file: &str) -> Result<Bitmap> {
     Ok(Bitmap { width, height, channels, data })
 }
 
-fn read_png(bytes: &[u8], file: &str, srgb_to_linear: bool) -> Result<Bitmap> {
+/// 8/16-bit formats decoded by the `image` crate.
+fn read_ldr(bytes: &[u8], file: &str, srgb_to_linear: bool, format: image::ImageFormat) -> Result<Bitmap> {
     use image::DynamicImage as D;
-    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
-        .map_err(|e| Error::in_file(file, format!("cannot decode PNG: {e}")))?;
+    let name = format!("{format:?}").to_uppercase();
+    let img = image::load_from_memory_with_format(bytes, format)
+        .map_err(|e| Error::in_file(file, format!("cannot decode {name}: {e}")))?;
     let (width, height) = (img.width() as usize, img.height() as usize);
     let (names, alpha, data): (&[&str], bool, Vec<f32>) = match img {
         D::ImageLuma8(i) => (&["Y"], false, unorm8(i.as_raw())),
@@ -164,7 +184,7 @@ fn read_png(bytes: &[u8], file: &str, srgb_to_linear: bool) -> Result<Bitmap> {
         D::ImageRgb16(i) => (&["R", "G", "B"], false, unorm16(i.as_raw())),
         D::ImageRgba16(i) => (&["R", "G", "B", "A"], true, unorm16(i.as_raw())),
         other => {
-            return Err(Error::in_file(file, format!("unsupported PNG pixel type {:?}", other.color())));
+            return Err(Error::in_file(file, format!("unsupported {name} pixel type {:?}", other.color())));
         }
     };
     let mut data = data;
@@ -178,6 +198,71 @@ fn read_png(bytes: &[u8], file: &str, srgb_to_linear: bool) -> Result<Bitmap> {
         }
     }
     Ok(Bitmap { width, height, channels: names.iter().map(|s| s.to_string()).collect(), data })
+}
+
+/// Radiance RGBE (`.hdr`): linear RGB floats.
+fn read_rgbe(bytes: &[u8], file: &str) -> Result<Bitmap> {
+    // The decoder only accepts the "#?RADIANCE" signature; Mitsuba (and others) write "#?RGBE",
+    // which the format allows: normalise the first line.
+    let mut owned;
+    let mut bytes = bytes;
+    if !bytes.starts_with(b"#?RADIANCE\n") {
+        let end = bytes.iter().position(|&b| b == b'\n').unwrap_or(bytes.len());
+        owned = b"#?RADIANCE".to_vec();
+        owned.extend_from_slice(&bytes[end..]);
+        bytes = &owned;
+    }
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Hdr)
+        .map_err(|e| Error::in_file(file, format!("cannot decode RGBE: {e}")))?;
+    let (width, height) = (img.width() as usize, img.height() as usize);
+    let data = img.into_rgb32f().into_raw();
+    Ok(Bitmap { width, height, channels: vec!["R".into(), "G".into(), "B".into()], data })
+}
+
+/// Portable float map: header "PF" (RGB) or "Pf" (grey), width height, scale (negative: little
+/// endian), then rows of f32 from the bottom row up.
+fn read_pfm(bytes: &[u8], file: &str) -> Result<Bitmap> {
+    let bad = |msg: &str| Error::in_file(file, format!("cannot decode PFM: {msg}"));
+    // Three whitespace-separated header fields after the magic, then one whitespace byte.
+    let mut fields = Vec::new();
+    let mut i = 2;
+    while fields.len() < 3 {
+        while i < bytes.len() && bytes[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        let start = i;
+        while i < bytes.len() && !bytes[i].is_ascii_whitespace() {
+            i += 1;
+        }
+        if start == i {
+            return Err(bad("truncated header"));
+        }
+        fields.push(std::str::from_utf8(&bytes[start..i]).map_err(|_| bad("invalid header"))?.to_string());
+    }
+    i += 1;
+    let parse_usize = |s: &str| s.parse::<usize>().map_err(|_| bad(&format!("invalid size \"{s}\"")));
+    let (width, height) = (parse_usize(&fields[0])?, parse_usize(&fields[1])?);
+    let scale: f32 = fields[2].parse().map_err(|_| bad(&format!("invalid scale \"{}\"", fields[2])))?;
+    if scale == 0.0 || !scale.is_finite() {
+        return Err(bad("the scale must be non-zero"));
+    }
+    let nc = if bytes[1] == b'F' { 3 } else { 1 };
+    let count = width.checked_mul(height).and_then(|n| n.checked_mul(nc)).ok_or_else(|| bad("image too large"))?;
+    let body = bytes.get(i..).unwrap_or(&[]);
+    if body.len() < count * 4 {
+        return Err(bad(&format!("expected {} bytes of pixel data, found {}", count * 4, body.len())));
+    }
+    let mut data = vec![0.0f32; count];
+    let row = width * nc;
+    for (k, chunk) in body[..count * 4].chunks_exact(4).enumerate() {
+        let b = [chunk[0], chunk[1], chunk[2], chunk[3]];
+        let v = if scale < 0.0 { f32::from_le_bytes(b) } else { f32::from_be_bytes(b) };
+        // Row k / row counts from the bottom.
+        let (y, x) = (k / row, k % row);
+        data[(height - 1 - y) * row + x] = v;
+    }
+    let channels = if nc == 3 { vec!["R".into(), "G".into(), "B".into()] } else { vec!["Y".into()] };
+    Ok(Bitmap { width, height, channels, data })
 }
 
 fn unorm8(v: &[u8]) -> Vec<f32> {

@@ -1,11 +1,12 @@
-//! Bitmap texture (`bitmap`): an image (OpenEXR or PNG) looked up at uv.
+//! Bitmap texture (`bitmap`): an image looked up at uv. Formats (those Mitsuba's `bitmap` reads,
+//! decoded by [`read_image`]): OpenEXR, PNG, JPEG, BMP, TGA, Radiance RGBE (`.hdr`) and PFM.
 //!
 //! | parameter     | type      | meaning |
 //! |---------------|-----------|---------|
 //! | `filename`    | string    | the image, resolved against the scene's folders |
 //! | `filter_type` | string    | `bilinear` (default) or `nearest` |
 //! | `wrap_mode`   | string    | outside [0, 1]: `repeat` (default), `mirror` or `clamp` |
-//! | `raw`         | boolean   | keep 8/16-bit data as stored instead of converting sRGB to linear (default false) |
+//! | `raw`         | boolean   | keep 8/16-bit data (PNG, JPEG, BMP, TGA) as stored instead of converting sRGB to linear (default false); float formats (EXR, RGBE, PFM) are always linear |
 //! | `to_uv`       | transform | uv transform (3×3; of a 4×4 matrix the third row and column are ignored) |
 //! | `format`, `accel` | string, boolean | Mitsuba's storage options; accepted and ignored (data is kept in f32) |
 //!
