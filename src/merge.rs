@@ -336,18 +336,18 @@ pub fn merge(parts: &[Part], allow_partial: bool) -> anyhow::Result<Part> {
     };
     let gaps: Vec<(u32, u32)> =
         missing_ranges(&ranges, spp).into_iter().filter(|r| r.0 >= union.0 && r.1 <= union.1).collect();
+    let missing = missing_ranges(&ranges, spp);
+    if !allow_partial && !missing.is_empty() {
+        bail!(
+            "samples {} of {spp} per pixel are missing (the parts hold {}); render them with --sample-range, or merge with --partial",
+            format_ranges(&missing),
+            format_ranges(&ranges)
+        );
+    }
     if !gaps.is_empty() {
         bail!(
             "the parts leave gaps: samples {} missing (the parts hold {})",
             format_ranges(&gaps),
-            format_ranges(&ranges)
-        );
-    }
-    if !allow_partial && union != (0, spp) {
-        let missing = missing_ranges(&ranges, spp);
-        bail!(
-            "samples {} of {spp} per pixel are missing (the parts hold {}); render them with --sample-range, or merge with --partial",
-            format_ranges(&missing),
             format_ranges(&ranges)
         );
     }
