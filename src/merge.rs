@@ -157,7 +157,7 @@ pub fn scene_fingerprint(path: &Path, defines: &[(String, String)]) -> anyhow::R
     for (k, v) in defines {
         eat(&[0]);
         eat(k.as_bytes());
-        eat(&[b'=']);
+        eat(b"=");
         eat(v.as_bytes());
     }
     Ok(format!("{h:016x}"))
