@@ -56,15 +56,22 @@ def split_ranges(spp, tasks):
 
 
 def render_part(snee, scene, start, end, args):
-    """Run snee for samples start..end; return the partial EXR's bytes (raises with snee's message on failure)."""
+    """Run snee for samples start..end; return the partial EXR's bytes (raises with snee's message on failure).
+
+    With --checkpoint-dir the task checkpoints into DIR/part_START_END.exr and a retried task
+    resumes from the checkpoint it finds there (on a shared folder, whichever node runs it)."""
     with tempfile.TemporaryDirectory(prefix="snee-part-") as tmp:
-        out = os.path.join(tmp, f"part_{start}_{end}.exr")
+        out = os.path.join(args.checkpoint_dir or tmp, f"part_{start}_{end}.exr")
         cmd = [snee, "render", scene, "-o", out, "--spp", str(args.spp), "--seed", str(args.seed),
                "--sample-range", f"{start}..{end}", "--threads", str(args.cpus_per_task), "-q"]
         for d in args.define:
             cmd += ["-D", d]
         if args.moment:
             cmd.append("--moment")
+        if args.checkpoint_dir:
+            cmd += ["--checkpoint", str(args.checkpoint)]
+            if os.path.exists(out):
+                cmd += ["--resume", out]
         r = subprocess.run(cmd, capture_output=True, text=True)
         if r.returncode != 0:
             raise RuntimeError(f"snee failed on samples {start}..{end}: {r.stderr.strip()}")
@@ -93,6 +100,9 @@ def main():
     ap.add_argument("--num-cpus", type=int, default=None, help="CPUs of the local cluster (default: all)")
     ap.add_argument("--max-retries", type=int, default=3, help="retries of a task whose worker or node dies")
     ap.add_argument("--snee", default=os.path.join(REPO, "target", "release", "snee"), help="snee binary (same path on every node)")
+    ap.add_argument("--checkpoint-dir", default=None, metavar="DIR",
+                    help="tasks checkpoint into DIR (a folder every node sees) and retries resume from there")
+    ap.add_argument("--checkpoint", type=float, default=60.0, metavar="SECONDS", help="checkpoint interval of tasks")
     ap.add_argument("--keep-parts", default=None, metavar="DIR", help="also keep the partial EXRs in DIR")
     ap.add_argument("-q", "--quiet", action="store_true")
     args = ap.parse_args()
@@ -102,6 +112,9 @@ def main():
     import ray  # imported here so that --help works without Ray
 
     snee = os.path.abspath(args.snee)
+    if args.checkpoint_dir:
+        args.checkpoint_dir = os.path.abspath(args.checkpoint_dir)
+        os.makedirs(args.checkpoint_dir, exist_ok=True)
     scene = os.path.abspath(args.scene)
     for path, what in ((snee, "snee binary"), (scene, "scene")):
         if not os.path.exists(path):

@@ -157,21 +157,38 @@ fn python_with_ray() -> &'static str {
     "python3"
 }
 
+/// Through a local Ray cluster started by the driver: 3 tasks, one of whose workers is killed
+/// (SIGKILL) on its first attempt by a wrapper around snee, so the task must be retried; the merged
+/// image matches the single-process render.
 #[test]
 fn ray_local_cluster_merge_matches_single_process() {
     let python = python_with_ray();
     let dir = folder("ray");
     let single = single_run(&dir);
+    let wrapper = dir.join("snee-killing-its-worker.sh");
+    let marker = dir.join("worker-killed");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\nif [ \"$1\" = render ] && mkdir {marker} 2>/dev/null; then kill -9 $PPID; sleep 10; exit 1; fi\nexec {SNEE} \"$@\"\n",
+            marker = marker.display()
+        ),
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
     let out = dir.join("ray.exr");
     let spp = SPP.to_string();
     let mut args = vec!["scripts/ray_render.py", SCENE, "-o", out.to_str().unwrap(), "--spp", &spp];
-    args.extend(["--seed", SEED, "--moment", "--tasks", "3", "--num-cpus", "2", "--snee", SNEE, "-q"]);
+    args.extend(["--seed", SEED, "--moment", "--tasks", "3", "--num-cpus", "2", "-q"]);
+    args.extend(["--snee", wrapper.to_str().unwrap()]);
     args.extend(FILM);
     let st = Command::new(python).args(&args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap();
     assert!(st.status.success(), "ray_render.py failed: {}", String::from_utf8_lossy(&st.stderr));
+    assert!(marker.exists(), "no worker was killed: the retry was not exercised");
     let merged = read_image(&out, false).unwrap();
     let d = max_rel_diff(&single, &merged);
-    eprintln!("Ray, 3 tasks: max relative difference {d:e}");
+    eprintln!("Ray, 3 tasks, one worker killed and its task retried: max relative difference {d:e}");
     assert!(d <= REL_TOL, "Ray: max relative difference {d:e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
