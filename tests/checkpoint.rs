@@ -150,3 +150,37 @@ fn output_extension_decides_the_format() {
     assert!(!run(&args).status.success());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--resume` continues any prefix of the samples to render — here a `--sample-range 3..9` part
+/// continued to `3..21` — and equals the direct render of `3..21`; a part that is not a prefix
+/// (`5..9`) is refused.
+#[test]
+fn resume_continues_a_prefix_of_a_sample_range() {
+    let dir = folder("range");
+    let path = |n: &str| dir.join(n).to_str().unwrap().to_string();
+    let (prefix, resumed, direct) = (path("prefix.exr"), path("resumed.exr"), path("direct.exr"));
+    let base = |out: &str| {
+        let mut a: Vec<String> =
+            ["render", SCENE, "-o", out, "--spp", "21", "--seed", "5", "--moment", "-q"].map(String::from).to_vec();
+        a.extend(FILM.map(String::from));
+        a
+    };
+    let go = |mut a: Vec<String>, extra: &[&str]| {
+        a.extend(extra.iter().map(|s| s.to_string()));
+        let refs: Vec<&str> = a.iter().map(|s| s.as_str()).collect();
+        run(&refs)
+    };
+    assert!(go(base(&prefix), &["--sample-range", "3..9"]).status.success());
+    let o = go(base(&resumed), &["--sample-range", "3..21", "--resume", &prefix]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(go(base(&direct), &["--sample-range", "3..21"]).status.success());
+    let part = snee::merge::Part::read(Path::new(&resumed)).unwrap();
+    assert_eq!(part.meta.range, (3, 21));
+    let d =
+        max_rel_diff(&read_image(Path::new(&direct), false).unwrap(), &read_image(Path::new(&resumed), false).unwrap());
+    eprintln!("range resumed vs direct: max relative difference {d:e}");
+    assert!(d <= REL_TOL, "max relative difference {d:e}");
+    let o = go(base(&resumed), &["--sample-range", "5..21", "--resume", &prefix]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("3..9"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
