@@ -123,7 +123,9 @@ def main():
     if args.address:
         ray.init(address=args.address, log_to_driver=False)
     else:
-        ray.init(num_cpus=args.num_cpus, include_dashboard=False, log_to_driver=False)
+        # address="local": always a new cluster on this machine, never one found in RAY_ADDRESS
+        # or left over from an earlier `ray start`.
+        ray.init(address="local", num_cpus=args.num_cpus, include_dashboard=False, log_to_driver=False)
     try:
         cpus = int(ray.cluster_resources().get("CPU", 1))
         tasks = args.tasks or max(1, 4 * cpus // args.cpus_per_task)
