@@ -17,6 +17,7 @@ pub mod interaction;
 pub mod io;
 pub mod math;
 pub mod medium;
+pub mod merge;
 pub mod render;
 pub mod sampler;
 pub mod scene;

@@ -1,4 +1,4 @@
-//! `snee` command line: `info`, `render`, `compare`. All work happens in the library; this file
+//! `snee` command line: `info`, `render`, `compare`, `merge`. All work happens in the library; this file
 //! parses arguments, calls it, and prints errors as `file:line:col: message`.
 
 use anyhow::{anyhow, Context};
@@ -73,6 +73,32 @@ enum Command {
         /// Write (seconds, spp, relMSE against --reference) at doubling sample counts as CSV.
         #[arg(long, value_name = "FILE.csv", requires = "reference")]
         convergence: Option<PathBuf>,
+        /// Render only samples START..END-1 of every pixel (of the spp the scene or --spp sets, same
+        /// seed): a part of the full run, with weights and metadata, for `snee merge`.
+        #[arg(long, value_name = "START..END")]
+        sample_range: Option<String>,
+        /// Every SECONDS (at the end of a pass), write the image so far to the output, with its
+        /// sample range and weights, so that `--resume` can continue it after a crash.
+        #[arg(long, value_name = "SECONDS")]
+        checkpoint: Option<f64>,
+        /// Continue a checkpoint or partial render of the same scene, seed and spp (output
+        /// default: the same file); the result equals an uninterrupted run.
+        #[arg(long, value_name = "PARTIAL.exr")]
+        resume: Option<PathBuf>,
+    },
+    /// Merge partial renders of one run (--sample-range, --checkpoint) into one image.
+    Merge {
+        /// Partial EXRs of the same scene, seed and spp, with disjoint sample ranges.
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        /// Output EXR (a part itself: it can be merged again).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Accept parts covering one contiguous range short of the whole run.
+        #[arg(long)]
+        partial: bool,
+        #[arg(long, short)]
+        quiet: bool,
     },
     /// Compare two EXR images: MSE, relMSE, mean ratio, and a per-pixel Z-test when variances are present.
     Compare {
@@ -144,6 +170,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             moment,
             reference,
             convergence,
+            sample_range,
+            checkpoint,
+            resume,
         } => {
             // Before loading: building the BVH already starts rayon's global pool.
             if let Some(t) = threads {
@@ -151,6 +180,25 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             let scene_path = scene.unwrap_or_else(|| PathBuf::from(DEFAULT_SCENE));
             let defines = parse_defines(&define)?;
+            // Output format and part options are checked before any work starts.
+            let output = output.or_else(|| resume.clone());
+            let output_png = match &output {
+                Some(o) => output_is_png(o)?,
+                None => false,
+            };
+            let part_mode = sample_range.is_some() || checkpoint.is_some() || resume.is_some();
+            if output_png && (part_mode || moment) {
+                return Err(anyhow!(
+                    "-o {}: --moment, --sample-range, --checkpoint and --resume need an .exr output (PNG holds 8-bit colour only)",
+                    output.as_deref().unwrap_or(Path::new("")).display()
+                ));
+            }
+            let sample_range = sample_range.as_deref().map(parse_sample_range).transpose()?;
+            if let Some(c) = checkpoint {
+                if !(c >= 0.0 && c.is_finite()) {
+                    return Err(anyhow!("--checkpoint expects a number of seconds >= 0, got {c}"));
+                }
+            }
             let mut loaded = load_scene(&scene_path, &defines)?;
             loaded.integrator.moment |= moment;
             if let Some(t) = time {
@@ -169,6 +217,11 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 let _ = ctrlc::set_handler(move || c.store(true, Ordering::Relaxed));
             }
             let opts = snee::render::RenderOptions { spp, seed, time_budget: time, progress: !quiet };
+            let part = if part_mode {
+                Some(PartRun::new(&scene_path, &defines, &loaded, &opts, sample_range, resume.as_deref())?)
+            } else {
+                None
+            };
             let reference = match &reference {
                 Some(r) => Some(
                     snee::compare::rgb_of(&snee::io::read::read_image(r, false)?)
@@ -186,11 +239,27 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     }
                 }
             };
-            let out = snee::render::render_with(
+            let mut last_checkpoint = std::time::Instant::now();
+            let mut on_pass = |state: &snee::render::PassState| {
+                if reference.is_some() && state.samples.1.is_power_of_two() {
+                    record(state.seconds, state.samples.1, &state.develop());
+                }
+                if let (Some(every), Some(run)) = (checkpoint, &part) {
+                    if last_checkpoint.elapsed().as_secs_f64() >= every && state.samples.1 < run.range.1 {
+                        if let Err(e) = run.write_checkpoint(&output, state) {
+                            eprintln!("warning: checkpoint not written: {e:#}");
+                        }
+                        last_checkpoint = std::time::Instant::now();
+                    }
+                }
+            };
+            let wants_passes = reference.is_some() || checkpoint.is_some();
+            let out = snee::render::render_range(
                 &loaded,
                 &opts,
+                part.as_ref().map(|p| (p.next_sample(), p.range.1)),
                 &cancel,
-                reference.as_ref().map(|_| &mut record as snee::render::PassCallback),
+                if wants_passes { Some(&mut on_pass as snee::render::ProgressCallback) } else { None },
             );
             if let (Some(r), Some(path)) = (&reference, &convergence) {
                 if r.len() != out.width * out.height {
@@ -200,15 +269,21 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 for (t, spp, e) in &rows {
                     csv += &format!("{t:.6},{spp},{e:.6e}\n");
                 }
-                std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))?;
+                snee::io::atomic::write_bytes(path, csv.as_bytes())?;
             }
-            write_output(&output, &out, png)?;
+            match &part {
+                Some(run) => run.write_final(&output, &out, png)?,
+                None if output_png => write_png_output(&output, &out)?,
+                None => write_output(&output, &out, png)?,
+            }
             let st = out.stats.to_json();
             if let Some(p) = stats {
-                std::fs::write(&p, serde_json::to_string_pretty(&st)?)
-                    .with_context(|| format!("writing {}", p.display()))?;
+                snee::io::atomic::write_bytes(&p, serde_json::to_string_pretty(&st)?.as_bytes())?;
             }
             if !quiet {
+                if output_png {
+                    eprintln!("note: {} is an 8-bit sRGB PNG; name the output .exr for float data", output.display());
+                }
                 eprintln!(
                     "wrote {} ({}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {} rejected samples)",
                     output.display(),
@@ -218,6 +293,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     out.stats.seconds,
                     out.stats.samples as f64 / out.stats.seconds.max(1e-9) / 1e6,
                     out.stats.rejected_samples
+                );
+            }
+            Ok(())
+        }
+        Command::Merge { parts, output, partial, quiet } => {
+            if output_is_png(&output)? {
+                return Err(anyhow!("-o {}: merge writes an .exr (a part that can be merged again)", output.display()));
+            }
+            let parts = parts.iter().map(|p| snee::merge::Part::read(p)).collect::<anyhow::Result<Vec<_>>>()?;
+            let merged = snee::merge::merge(&parts, partial)?;
+            ensure_parent(&output)?;
+            merged.write(&output)?;
+            if !quiet {
+                eprintln!(
+                    "wrote {} ({} parts, samples {}..{} of {} spp)",
+                    output.display(),
+                    parts.len(),
+                    merged.meta.range.0,
+                    merged.meta.range.1,
+                    merged.meta.spp
                 );
             }
             Ok(())
@@ -265,9 +360,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
 }
 
 fn write_output(path: &Path, out: &snee::render::RenderOutput, png: bool) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating the folder {}", dir.display()))?;
-    }
+    ensure_parent(path)?;
     let names: Vec<&str> = out.channels.iter().map(|s| s.as_str()).collect();
     snee::io::write::write_exr(path, out.width, out.height, &names, &out.data)?;
     if png {
@@ -277,4 +370,147 @@ fn write_output(path: &Path, out: &snee::render::RenderOutput, png: bool) -> any
         snee::io::write::write_png(&png_path, out.width, out.height, &rgb)?;
     }
     Ok(())
+}
+
+fn ensure_parent(path: &Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating the folder {}", dir.display()))?;
+    }
+    Ok(())
+}
+
+/// Whether `-o` names a PNG (`true`) or an EXR (`false`); an error for any other extension.
+fn output_is_png(path: &Path) -> anyhow::Result<bool> {
+    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+        Some("exr") => Ok(false),
+        Some("png") => Ok(true),
+        other => Err(anyhow!(
+            "-o {}: snee writes OpenEXR (.exr) or 8-bit PNG (.png), not {}",
+            path.display(),
+            other.map(|e| format!("\".{e}\"")).unwrap_or_else(|| "a file without extension".into())
+        )),
+    }
+}
+
+/// `-o NAME.png`: the colour channels as an 8-bit sRGB PNG, nothing else.
+fn write_png_output(path: &Path, out: &snee::render::RenderOutput) -> anyhow::Result<()> {
+    ensure_parent(path)?;
+    let n = out.channels.len();
+    let rgb: Vec<f32> = out.data.chunks(n).flat_map(|p| [p[0], p[1], p[2]]).collect();
+    snee::io::write::write_png(path, out.width, out.height, &rgb)
+}
+
+/// `--sample-range START..END` with START < END.
+fn parse_sample_range(text: &str) -> anyhow::Result<(u32, u32)> {
+    let bad = || anyhow!("--sample-range expects START..END with integers 0 <= START < END, got \"{text}\"");
+    let (a, b) = text.split_once("..").ok_or_else(bad)?;
+    let (a, b): (u32, u32) = (a.trim().parse().map_err(|_| bad())?, b.trim().parse().map_err(|_| bad())?);
+    if a >= b {
+        return Err(bad());
+    }
+    Ok((a, b))
+}
+
+/// A render that produces a part (`--sample-range`, `--checkpoint`, `--resume`): its metadata,
+/// the target sample range, and the partial image it continues.
+struct PartRun {
+    meta: snee::merge::PartMeta,
+    /// Samples this run completes: `range.0..range.1` of every pixel.
+    range: (u32, u32),
+    resumed: Option<snee::merge::Part>,
+}
+
+impl PartRun {
+    fn new(
+        scene_path: &Path,
+        defines: &[(String, String)],
+        scene: &snee::scene::world::Scene,
+        opts: &snee::render::RenderOptions,
+        sample_range: Option<(u32, u32)>,
+        resume: Option<&Path>,
+    ) -> anyhow::Result<PartRun> {
+        let spp = snee::render::total_spp(scene, opts);
+        if spp == u32::MAX {
+            return Err(anyhow!(
+                "--sample-range, --checkpoint and --resume need a sample count: give --spp (with --time the render stops at whichever comes first)"
+            ));
+        }
+        let range = sample_range.unwrap_or((0, spp));
+        if range.1 > spp {
+            return Err(anyhow!("--sample-range {}..{}: the run has {spp} samples per pixel", range.0, range.1));
+        }
+        let film = &scene.film;
+        let meta = snee::merge::PartMeta {
+            scene: scene_path.display().to_string(),
+            scene_hash: snee::merge::scene_fingerprint(scene_path, defines)?,
+            defines: defines.to_vec(),
+            integrator: snee::merge::integrator_name(scene.integrator.kind).to_string(),
+            seed: opts.seed,
+            spp,
+            range,
+            film: (film.width, film.height),
+            crop: [film.crop_offset.0, film.crop_offset.1, film.crop_size.0, film.crop_size.1],
+            moment: scene.integrator.moment,
+            version: env!("CARGO_PKG_VERSION").to_string(),
+        };
+        let resumed = match resume {
+            None => None,
+            Some(path) => {
+                let part = snee::merge::Part::read(path)?;
+                meta.check_same_run(&part.meta)
+                    .map_err(|e| anyhow!("--resume {}: not a part of this render: {e}", path.display()))?;
+                let (s, e) = part.meta.range;
+                if s != range.0 || e > range.1 {
+                    return Err(anyhow!(
+                        "--resume {}: holds samples {s}..{e}, which is not a start of the samples {}..{} to render",
+                        path.display(),
+                        range.0,
+                        range.1
+                    ));
+                }
+                Some(part)
+            }
+        };
+        Ok(PartRun { meta, range, resumed })
+    }
+
+    /// The first sample this process renders.
+    fn next_sample(&self) -> u32 {
+        self.resumed.as_ref().map_or(self.range.0, |p| p.meta.range.1)
+    }
+
+    /// The resumed part (if any) plus `new`.
+    fn combine(&self, new: snee::merge::Part) -> anyhow::Result<snee::merge::Part> {
+        match &self.resumed {
+            Some(old) => snee::merge::merge(&[old.clone(), new], true),
+            None => Ok(new),
+        }
+    }
+
+    fn write_checkpoint(&self, output: &Path, state: &snee::render::PassState) -> anyhow::Result<()> {
+        let (width, height) = (self.meta.crop[2] as usize, self.meta.crop[3] as usize);
+        let new = snee::merge::Part {
+            source: "checkpoint".into(),
+            meta: snee::merge::PartMeta { range: state.samples, ..self.meta.clone() },
+            width,
+            height,
+            channels: state.channels.to_vec(),
+            data: state.develop(),
+            weights: state.weights(),
+        };
+        ensure_parent(output)?;
+        self.combine(new)?.write(output)
+    }
+
+    fn write_final(&self, output: &Path, out: &snee::render::RenderOutput, png: bool) -> anyhow::Result<()> {
+        let part = self.combine(snee::merge::Part::from_render("render", self.meta.clone(), out))?;
+        ensure_parent(output)?;
+        part.write(output)?;
+        if png {
+            let n = part.channels.len();
+            let rgb: Vec<f32> = part.data.chunks(n).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            snee::io::write::write_png(&output.with_extension("png"), part.width, part.height, &rgb)?;
+        }
+        Ok(())
+    }
 }

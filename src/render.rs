@@ -1,8 +1,15 @@
 //! The render loop: rayon over 16×16 tiles in passes of samples per pixel, filtered accumulation
 //! into the film, a progress bar, a time budget, Ctrl-C, and render statistics.
 //!
-//! Determinism: every (pixel, pass) has its own sampler stream derived from the seed, so an image
-//! depends only on the seed and the sample count, never on the thread count or tile order.
+//! Determinism: the samples of a pixel are cut into fixed chunks — `[0,1) [1,2) [2,4) [4,8) …
+//! [32,64)`, then every 64 samples — and each (pixel, chunk) has its own sampler stream derived
+//! from the seed and the chunk's first sample index ([`chunk_start`]). The random numbers of
+//! sample `i` of a pixel therefore depend only on the pixel, `i` and the seed: never on the
+//! thread count, the tile order, the time budget, or which process renders it. A render of the
+//! sample range `START..END` ([`render_range`]) takes exactly the samples `START..END` of the
+//! full run (a range that starts inside a chunk replays the chunk's earlier samples without
+//! recording them, so ranges on chunk boundaries cost nothing extra), and ranges merge into the
+//! full image up to float summation order (`merge`).
 
 use crate::color::Spectrum;
 use crate::integrator::stats::{LocalStats, Stats};
@@ -35,6 +42,12 @@ pub struct RenderOutput {
     pub channels: Vec<String>,
     /// Interleaved channels, row 0 = top.
     pub data: Vec<f32>,
+    /// Accumulated reconstruction-filter weight per pixel (row 0 = top): the developed value
+    /// times this weight is the pixel's sum of weighted samples, which is what merging adds up.
+    pub weights: Vec<f32>,
+    /// Index of the first sample per pixel in this image: it holds samples
+    /// `first_sample..first_sample + stats.spp` of every pixel.
+    pub first_sample: u32,
     pub stats: RenderStats,
 }
 
@@ -72,6 +85,66 @@ fn sample_li(scene: &Scene, sampler: &mut Sampler, ray: crate::math::Ray, stats:
     scene.integrator.li(scene, sampler, ray, stats)
 }
 
+/// First sample index of the chunk that contains sample `i` (chunks: `[0,1) [1,2) [2,4) … [32,64)`,
+/// then `[64k, 64k+64)`). Every (pixel, chunk) has one sampler stream, and a pass never spans
+/// two chunks.
+pub fn chunk_start(i: u32) -> u32 {
+    match i {
+        0 => 0,
+        1..=63 => 1 << (31 - i.leading_zeros()),
+        _ => i & !63,
+    }
+}
+
+/// One past the last sample index of the chunk that contains sample `i`.
+pub fn chunk_end(i: u32) -> u32 {
+    match i {
+        0 => 1,
+        1..=63 => 2 * chunk_start(i),
+        _ => chunk_start(i).saturating_add(64),
+    }
+}
+
+/// Samples per pixel of a full run: `--spp`, else the scene's `sample_count`; `u32::MAX`
+/// (unbounded) when only a time budget is given.
+pub fn total_spp(scene: &Scene, opts: &RenderOptions) -> u32 {
+    match (opts.spp, opts.time_budget) {
+        (Some(s), _) => s,
+        (None, Some(_)) => u32::MAX,
+        (None, None) => scene.sampler.sample_count,
+    }
+}
+
+/// The state of a render after a complete pass, given to [`render_range`]'s callback.
+pub struct PassState<'a> {
+    /// Render time so far in seconds (time spent in callbacks not counted).
+    pub seconds: f64,
+    /// The image holds samples `samples.0..samples.1` of every pixel.
+    pub samples: (u32, u32),
+    /// Channel names of the image.
+    pub channels: &'a [String],
+    block: &'a ImageBlock,
+}
+
+impl PassState<'_> {
+    /// The developed image (channels interleaved as in [`RenderOutput`]).
+    pub fn develop(&self) -> Vec<f32> {
+        self.block.develop()
+    }
+    /// Accumulated filter weight per pixel (see [`RenderOutput::weights`]).
+    pub fn weights(&self) -> Vec<f32> {
+        block_weights(self.block)
+    }
+}
+
+fn block_weights(block: &ImageBlock) -> Vec<f32> {
+    let (w, h) = block.size();
+    (0..h).flat_map(|y| (0..w).map(move |x| block.weight(x, y))).collect()
+}
+
+/// Called after every complete pass of [`render_range`].
+pub type ProgressCallback<'a> = &'a mut dyn FnMut(&PassState);
+
 /// Render the scene. `cancel` stops early (Ctrl-C); the samples done so far are kept.
 pub fn render(scene: &Scene, opts: &RenderOptions, cancel: &AtomicBool) -> RenderOutput {
     render_with(scene, opts, cancel, None)
@@ -87,7 +160,31 @@ pub fn render_with(
     scene: &Scene,
     opts: &RenderOptions,
     cancel: &AtomicBool,
-    mut on_pass: Option<PassCallback>,
+    on_pass: Option<PassCallback>,
+) -> RenderOutput {
+    match on_pass {
+        None => render_range(scene, opts, None, cancel, None),
+        Some(cb) => {
+            let mut at_powers_of_two = |state: &PassState| {
+                if state.samples.1.is_power_of_two() {
+                    cb(state.seconds, state.samples.1, &state.develop());
+                }
+            };
+            render_range(scene, opts, None, cancel, Some(&mut at_powers_of_two))
+        }
+    }
+}
+
+/// Render samples `range.0..range.1` of every pixel (all of [`total_spp`] when `None`; the end is
+/// clipped to it), calling `on_pass` after every complete pass. Only complete passes enter the
+/// image: a render stopped by `cancel` or the time budget holds samples
+/// `range.0..range.0 + stats.spp` exactly.
+pub fn render_range(
+    scene: &Scene,
+    opts: &RenderOptions,
+    range: Option<(u32, u32)>,
+    cancel: &AtomicBool,
+    mut on_pass: Option<ProgressCallback>,
 ) -> RenderOutput {
     let film = &scene.film;
     let (cw, ch) = film.crop_size;
@@ -107,10 +204,10 @@ pub fn render_with(
     }
     let nch = channels.len();
     let ray_weight = scene.camera.ray_weight();
-    let total_spp = match (opts.spp, opts.time_budget) {
-        (Some(s), _) => s,
-        (None, Some(_)) => u32::MAX,
-        (None, None) => scene.sampler.sample_count,
+    let total_spp = total_spp(scene, opts);
+    let (start_sample, end_sample) = match range {
+        Some((s, e)) => (s.min(total_spp), e.min(total_spp)),
+        None => (0, total_spp),
     };
 
     let mut tiles = Vec::new();
@@ -124,7 +221,7 @@ pub fn render_with(
     let start = Instant::now();
     let pixels = sw as u64 * sh as u64;
     let bar = if opts.progress {
-        let len = if total_spp == u32::MAX { 0 } else { total_spp as u64 * pixels };
+        let len = if end_sample == u32::MAX { 0 } else { (end_sample - start_sample) as u64 * pixels };
         let b = indicatif::ProgressBar::new(len);
         b.set_style(
             indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}% ({eta} left) {msg}")
@@ -135,29 +232,53 @@ pub fn render_with(
         indicatif::ProgressBar::hidden()
     };
 
-    let mut spp_done = 0u32;
-    let mut pass = 0u64;
+    // One camera sample: film position, radiance (zero and counted when not finite), validity.
+    let take_sample = |sampler: &mut Sampler, local: &mut LocalStats, x: i32, y: i32| {
+        let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        let aperture = sampler.next_2d();
+        let ray = scene.camera.sample_ray(pos, aperture);
+        let (mut l, valid) = sample_li(scene, sampler, ray, local);
+        l *= ray_weight;
+        if !l.is_finite() {
+            local.rejected_samples += 1;
+            l = Spectrum::ZERO;
+        }
+        (pos, l, valid)
+    };
+
+    // Next sample index per pixel; the image holds samples start_sample..next.
+    let mut next = start_sample;
     let mut samples_done = 0u64;
     // Time spent in `on_pass`, excluded from the reported render time.
     let mut callback_seconds = 0.0f64;
-    while spp_done < total_spp && !cancel.load(Ordering::Relaxed) {
-        // Pass sizes 1, 1, 2, 4, ... 64 spp, so that passes end on every power of two; with a time budget, a pass is cut to what
-        // the measured rate says fits in the remaining time, and none starts that would end
-        // more than half a sample per pixel past the budget.
-        let mut pass_spp = (1u32 << pass.saturating_sub(1).min(6)).min(total_spp - spp_done);
+    while next < end_sample && !cancel.load(Ordering::Relaxed) {
+        // A pass is the rest of the chunk holding `next`: 1, 1, 2, 4, ... 64, 64, ... spp, so that
+        // passes end on every power of two. With a time budget, a pass is cut to what the
+        // measured rate says fits in the remaining time (and is then the last), and none starts
+        // that would end more than half a sample per pixel past the budget.
+        let chunk = chunk_start(next);
+        let mut pass_end = chunk_end(next).min(end_sample);
+        let mut last_pass = false;
         if let Some(t) = opts.time_budget {
-            let elapsed = start.elapsed().as_secs_f64();
+            let elapsed = start.elapsed().as_secs_f64() - callback_seconds;
+            let spp_done = next - start_sample;
             if spp_done > 0 {
                 let per_spp = elapsed / spp_done as f64;
                 let remaining = t - elapsed;
                 if remaining < 0.5 * per_spp {
                     break;
                 }
-                let fits = (remaining / per_spp).round().max(1.0);
-                pass_spp = pass_spp.min(fits.min(u32::MAX as f64) as u32);
+                let fits = (remaining / per_spp).round().max(1.0).min(u32::MAX as f64) as u32;
+                if fits < pass_end - next {
+                    pass_end = next + fits;
+                    last_pass = true;
+                }
             }
         }
-        let first_sample = spp_done;
+        let pass_spp = pass_end - next;
+        // Samples chunk..next of the chunk's stream are replayed (not recorded) when a range or a
+        // resumed render starts inside a chunk.
+        let replay = next - chunk;
         let completed = std::sync::atomic::AtomicU64::new(0);
         // Tiles render in parallel; their blocks merge in tile order so the floating-point sums (and
         // so the image) do not depend on the thread count.
@@ -169,25 +290,19 @@ pub fn render_with(
                 }
                 let mut block = ImageBlock::new((x0, y0), (w, h), film.filter, nch);
                 let mut local = LocalStats::default();
+                let mut replayed = LocalStats::default();
                 let mut values = vec![0.0f32; nch];
                 for y in y0..y0 + h as i32 {
                     for x in x0..x0 + w as i32 {
                         // Unique per film pixel (the border may lie outside the film: offset it).
                         let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
-                        let mut sampler = Sampler::new(
-                            opts.seed,
-                            pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(first_sample as u64),
-                        );
+                        let mut sampler =
+                            Sampler::new(opts.seed, pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(chunk as u64));
+                        for _ in 0..replay {
+                            take_sample(&mut sampler, &mut replayed, x, y);
+                        }
                         for _ in 0..pass_spp {
-                            let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-                            let aperture = sampler.next_2d();
-                            let ray = scene.camera.sample_ray(pos, aperture);
-                            let (mut l, valid) = sample_li(scene, &mut sampler, ray, &mut local);
-                            l *= ray_weight;
-                            if !l.is_finite() {
-                                local.rejected_samples += 1;
-                                l = Spectrum::ZERO;
-                            }
+                            let (pos, l, valid) = take_sample(&mut sampler, &mut local, x, y);
                             values[..3].copy_from_slice(&l.to_array());
                             let mut k = 3;
                             if rgba {
@@ -208,25 +323,31 @@ pub fn render_with(
                 Some(block)
             })
             .collect();
+        // A pass stopped part way is dropped whole, so the image holds whole sample ranges.
+        if cancel.load(Ordering::Relaxed) || blocks.iter().any(|b| b.is_none()) {
+            break;
+        }
         for block in blocks.iter().flatten() {
             full.merge(block);
         }
         samples_done += completed.load(Ordering::Relaxed);
-        if cancel.load(Ordering::Relaxed) {
-            break;
-        }
-        spp_done += pass_spp;
-        pass += 1;
+        next = pass_end;
         if let Some(cb) = on_pass.as_mut() {
-            if spp_done.is_power_of_two() {
-                let t = start.elapsed().as_secs_f64() - callback_seconds;
-                let t0 = Instant::now();
-                cb(t, spp_done, &full.develop());
-                callback_seconds += t0.elapsed().as_secs_f64();
-            }
+            let t0 = Instant::now();
+            let state = PassState {
+                seconds: start.elapsed().as_secs_f64() - callback_seconds,
+                samples: (start_sample, next),
+                channels: &channels,
+                block: &full,
+            };
+            cb(&state);
+            callback_seconds += t0.elapsed().as_secs_f64();
         }
-        if total_spp == u32::MAX {
-            bar.set_message(format!("{} spp", spp_done));
+        if end_sample == u32::MAX {
+            bar.set_message(format!("{} spp", next - start_sample));
+        }
+        if last_pass {
+            break;
         }
     }
     bar.finish_and_clear();
@@ -237,9 +358,11 @@ pub fn render_with(
         height: ch as usize,
         channels,
         data,
+        weights: block_weights(&full),
+        first_sample: start_sample,
         stats: RenderStats {
             seconds,
-            spp: spp_done,
+            spp: next - start_sample,
             samples: samples_done,
             rays: stats.rays.load(Ordering::Relaxed),
             rejected_samples: stats.rejected_samples.load(Ordering::Relaxed),

@@ -1,5 +1,6 @@
 //! Writing images: float32 EXR with any channel names (`R, G, B[, A]` plus extras such as
-//! `var.R`), and sRGB 8-bit PNG previews of linear RGB data.
+//! `var.R`) and optional text header attributes, and sRGB 8-bit PNG previews of linear RGB data.
+//! Both are written atomically ([`super::atomic`]): an existing file is replaced whole or not at all.
 
 use anyhow::{bail, Context};
 use std::path::Path;
@@ -7,6 +8,19 @@ use std::path::Path;
 /// Write a float32 OpenEXR file (ZIP compressed). `data` holds `width × height` pixels, row 0
 /// at the top, with one value per channel interleaved in the order of `channels`.
 pub fn write_exr(path: &Path, width: usize, height: usize, channels: &[&str], data: &[f32]) -> anyhow::Result<()> {
+    write_exr_with_attributes(path, width, height, channels, data, &[])
+}
+
+/// [`write_exr`] with extra text attributes `(name, value)` in the layer header (values are made
+/// ASCII: other characters become JSON-style `\uXXXX` escapes, see [`super::meta::to_ascii`]).
+pub fn write_exr_with_attributes(
+    path: &Path,
+    width: usize,
+    height: usize,
+    channels: &[&str],
+    data: &[f32],
+    attributes: &[(&str, &str)],
+) -> anyhow::Result<()> {
     use exr::prelude::*;
 
     let n = channels.len();
@@ -39,9 +53,17 @@ pub fn write_exr(path: &Path, width: usize, height: usize, channels: &[&str], da
         })
         .collect();
     let encoding = Encoding { compression: Compression::ZIP16, ..Encoding::default() };
-    let layer = Layer::new((width, height), LayerAttributes::default(), encoding, AnyChannels::sort(list));
-    Image::from_layer(layer).write().to_file(path).with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
+    let mut layer_attributes = LayerAttributes::default();
+    for (name, value) in attributes {
+        let (Some(n), Some(v)) = (Text::new_or_none(name), Text::new_or_none(super::meta::to_ascii(value))) else {
+            bail!("cannot write {}: attribute \"{name}\" is not representable", path.display());
+        };
+        layer_attributes.other.insert(n, AttributeValue::Text(v));
+    }
+    let layer = Layer::new((width, height), layer_attributes, encoding, AnyChannels::sort(list));
+    super::atomic::write_with(path, |tmp| {
+        Image::from_layer(layer).write().to_file(tmp).with_context(|| format!("writing {}", path.display()))
+    })
 }
 
 /// The sRGB transfer function (linear → display), as Mitsuba applies it when converting to 8 bit.
@@ -78,7 +100,8 @@ pub fn write_png(path: &Path, width: usize, height: usize, rgb: &[f32]) -> anyho
             (linear_to_srgb(v).clamp(0.0, 1.0) * 255.0 + 0.5) as u8
         })
         .collect();
-    image::save_buffer_with_format(path, &bytes, w, h, image::ColorType::Rgb8, image::ImageFormat::Png)
-        .with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
+    super::atomic::write_with(path, |tmp| {
+        image::save_buffer_with_format(tmp, &bytes, w, h, image::ColorType::Rgb8, image::ImageFormat::Png)
+            .with_context(|| format!("writing {}", path.display()))
+    })
 }
