@@ -218,7 +218,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             let opts = snee::render::RenderOptions { spp, seed, time_budget: time, progress: !quiet };
             let part = if part_mode {
-                Some(PartRun::new(&scene_path, &defines, &loaded, &opts, sample_range, resume.as_deref())?)
+                Some(snee::merge::PartRender::new(
+                    &scene_path,
+                    &defines,
+                    &loaded,
+                    &opts,
+                    sample_range,
+                    resume.as_deref(),
+                )?)
             } else {
                 None
             };
@@ -409,108 +416,4 @@ fn parse_sample_range(text: &str) -> anyhow::Result<(u32, u32)> {
         return Err(bad());
     }
     Ok((a, b))
-}
-
-/// A render that produces a part (`--sample-range`, `--checkpoint`, `--resume`): its metadata,
-/// the target sample range, and the partial image it continues.
-struct PartRun {
-    meta: snee::merge::PartMeta,
-    /// Samples this run completes: `range.0..range.1` of every pixel.
-    range: (u32, u32),
-    resumed: Option<snee::merge::Part>,
-}
-
-impl PartRun {
-    fn new(
-        scene_path: &Path,
-        defines: &[(String, String)],
-        scene: &snee::scene::world::Scene,
-        opts: &snee::render::RenderOptions,
-        sample_range: Option<(u32, u32)>,
-        resume: Option<&Path>,
-    ) -> anyhow::Result<PartRun> {
-        let spp = snee::render::total_spp(scene, opts);
-        if spp == u32::MAX {
-            return Err(anyhow!(
-                "--sample-range, --checkpoint and --resume need a sample count: give --spp (with --time the render stops at whichever comes first)"
-            ));
-        }
-        let range = sample_range.unwrap_or((0, spp));
-        if range.1 > spp {
-            return Err(anyhow!("--sample-range {}..{}: the run has {spp} samples per pixel", range.0, range.1));
-        }
-        let film = &scene.film;
-        let meta = snee::merge::PartMeta {
-            scene: scene_path.display().to_string(),
-            scene_hash: snee::merge::scene_fingerprint(scene_path, defines)?,
-            defines: defines.to_vec(),
-            integrator: snee::merge::integrator_name(scene.integrator.kind).to_string(),
-            seed: opts.seed,
-            spp,
-            range,
-            film: (film.width, film.height),
-            crop: [film.crop_offset.0, film.crop_offset.1, film.crop_size.0, film.crop_size.1],
-            moment: scene.integrator.moment,
-            version: env!("CARGO_PKG_VERSION").to_string(),
-        };
-        let resumed = match resume {
-            None => None,
-            Some(path) => {
-                let part = snee::merge::Part::read(path)?;
-                meta.check_same_run(&part.meta)
-                    .map_err(|e| anyhow!("--resume {}: not a part of this render: {e}", path.display()))?;
-                let (s, e) = part.meta.range;
-                if s != range.0 || e > range.1 {
-                    return Err(anyhow!(
-                        "--resume {}: holds samples {s}..{e}, which is not a start of the samples {}..{} to render",
-                        path.display(),
-                        range.0,
-                        range.1
-                    ));
-                }
-                Some(part)
-            }
-        };
-        Ok(PartRun { meta, range, resumed })
-    }
-
-    /// The first sample this process renders.
-    fn next_sample(&self) -> u32 {
-        self.resumed.as_ref().map_or(self.range.0, |p| p.meta.range.1)
-    }
-
-    /// The resumed part (if any) plus `new`.
-    fn combine(&self, new: snee::merge::Part) -> anyhow::Result<snee::merge::Part> {
-        match &self.resumed {
-            Some(old) => snee::merge::merge(&[old.clone(), new], true),
-            None => Ok(new),
-        }
-    }
-
-    fn write_checkpoint(&self, output: &Path, state: &snee::render::PassState) -> anyhow::Result<()> {
-        let (width, height) = (self.meta.crop[2] as usize, self.meta.crop[3] as usize);
-        let new = snee::merge::Part {
-            source: "checkpoint".into(),
-            meta: snee::merge::PartMeta { range: state.samples, ..self.meta.clone() },
-            width,
-            height,
-            channels: state.channels.to_vec(),
-            data: state.develop(),
-            weights: state.weights(),
-        };
-        ensure_parent(output)?;
-        self.combine(new)?.write(output)
-    }
-
-    fn write_final(&self, output: &Path, out: &snee::render::RenderOutput, png: bool) -> anyhow::Result<()> {
-        let part = self.combine(snee::merge::Part::from_render("render", self.meta.clone(), out))?;
-        ensure_parent(output)?;
-        part.write(output)?;
-        if png {
-            let n = part.channels.len();
-            let rgb: Vec<f32> = part.data.chunks(n).flat_map(|p| [p[0], p[1], p[2]]).collect();
-            snee::io::write::write_png(&output.with_extension("png"), part.width, part.height, &rgb)?;
-        }
-        Ok(())
-    }
 }

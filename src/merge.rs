@@ -18,6 +18,10 @@
 //! `v = Σ_k v_k·W_k / Σ_k W_k` — the spp-weighted mean of the means and of the second moments,
 //! equal to the single run up to float summation order. Parts must agree on everything but
 //! the range, and their ranges must be disjoint; `merge` names the missing ranges.
+//!
+//! [`PartRender`] is the render side: the metadata of a `--sample-range`/`--checkpoint`/`--resume`
+//! render, the samples it still has to take, and writing checkpoints and the final part (the
+//! resumed part merged with the new samples).
 
 use crate::integrator::IntegratorKind;
 use crate::render::RenderOutput;
@@ -383,6 +387,117 @@ pub fn merge(parts: &[Part], allow_partial: bool) -> anyhow::Result<Part> {
         data,
         weights,
     })
+}
+
+/// A render that produces a part (`--sample-range`, `--checkpoint`, `--resume`): its metadata,
+/// the target sample range, and the partial image it continues (checked to belong to the run).
+pub struct PartRender {
+    pub meta: PartMeta,
+    /// Samples this run completes: `range.0..range.1` of every pixel.
+    pub range: (u32, u32),
+    resumed: Option<Part>,
+}
+
+impl PartRender {
+    pub fn new(
+        scene_path: &Path,
+        defines: &[(String, String)],
+        scene: &crate::scene::world::Scene,
+        opts: &crate::render::RenderOptions,
+        sample_range: Option<(u32, u32)>,
+        resume: Option<&Path>,
+    ) -> anyhow::Result<PartRender> {
+        let spp = crate::render::total_spp(scene, opts);
+        if spp == u32::MAX {
+            return Err(anyhow!(
+                "--sample-range, --checkpoint and --resume need a sample count: give --spp (with --time the render stops at whichever comes first)"
+            ));
+        }
+        let range = sample_range.unwrap_or((0, spp));
+        if range.1 > spp {
+            return Err(anyhow!("--sample-range {}..{}: the run has {spp} samples per pixel", range.0, range.1));
+        }
+        let film = &scene.film;
+        let meta = PartMeta {
+            scene: scene_path.display().to_string(),
+            scene_hash: scene_fingerprint(scene_path, defines)?,
+            defines: defines.to_vec(),
+            integrator: integrator_name(scene.integrator.kind).to_string(),
+            seed: opts.seed,
+            spp,
+            range,
+            film: (film.width, film.height),
+            crop: [film.crop_offset.0, film.crop_offset.1, film.crop_size.0, film.crop_size.1],
+            moment: scene.integrator.moment,
+            version: env!("CARGO_PKG_VERSION").to_string(),
+        };
+        let resumed = match resume {
+            None => None,
+            Some(path) => {
+                let part = Part::read(path)?;
+                meta.check_same_run(&part.meta)
+                    .map_err(|e| anyhow!("--resume {}: not a part of this render: {e}", path.display()))?;
+                let (s, e) = part.meta.range;
+                if s != range.0 || e > range.1 {
+                    return Err(anyhow!(
+                        "--resume {}: holds samples {s}..{e}, which is not a start of the samples {}..{} to render",
+                        path.display(),
+                        range.0,
+                        range.1
+                    ));
+                }
+                Some(part)
+            }
+        };
+        Ok(PartRender { meta, range, resumed })
+    }
+
+    /// The first sample this process renders.
+    pub fn next_sample(&self) -> u32 {
+        self.resumed.as_ref().map_or(self.range.0, |p| p.meta.range.1)
+    }
+
+    /// The resumed part (if any) plus `new`.
+    fn combine(&self, new: Part) -> anyhow::Result<Part> {
+        match &self.resumed {
+            Some(old) => merge(&[old.clone(), new], true),
+            None => Ok(new),
+        }
+    }
+
+    pub fn write_checkpoint(&self, output: &Path, state: &crate::render::PassState) -> anyhow::Result<()> {
+        let (width, height) = (self.meta.crop[2] as usize, self.meta.crop[3] as usize);
+        let new = Part {
+            source: "checkpoint".into(),
+            meta: PartMeta { range: state.samples, ..self.meta.clone() },
+            width,
+            height,
+            channels: state.channels.to_vec(),
+            data: state.develop(),
+            weights: state.weights(),
+        };
+        create_parent(output)?;
+        self.combine(new)?.write(output)
+    }
+
+    pub fn write_final(&self, output: &Path, out: &crate::render::RenderOutput, png: bool) -> anyhow::Result<()> {
+        let part = self.combine(Part::from_render("render", self.meta.clone(), out))?;
+        create_parent(output)?;
+        part.write(output)?;
+        if png {
+            let n = part.channels.len();
+            let rgb: Vec<f32> = part.data.chunks(n).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            crate::io::write::write_png(&output.with_extension("png"), part.width, part.height, &rgb)?;
+        }
+        Ok(())
+    }
+}
+
+fn create_parent(path: &Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating the folder {}", dir.display()))?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
