@@ -135,10 +135,13 @@ pub fn image_header_size(path: &std::path::Path) -> Option<(u64, u64, u64)> {
 }
 
 /// Refuse an image file whose header declares more pixels than memory holds; `pos` is the
-/// position of the parameter naming the file.
+/// position of the parameter `param` naming the file (`param` may be empty).
 pub fn check_image(path: &std::path::Path, param: &str, pos: &SrcPos) -> Result<()> {
     match image_header_size(path) {
-        Some((w, h, c)) => check(image_bytes(w, h, c), &format!("{param}: the image ({w} x {h}, {c} channels)"), pos),
+        Some((w, h, c)) => {
+            let prefix = if param.is_empty() { String::new() } else { format!("{param}: ") };
+            check(image_bytes(w, h, c), &format!("{prefix}the image ({w} x {h}, {c} channels)"), pos)
+        }
         None => Ok(()),
     }
 }
