@@ -116,7 +116,7 @@ fn sampler_name(kind: SamplerKind) -> &'static str {
 fn color_text(c: Spectrum) -> String {
     let [r, g, b] = c.to_array();
     if r == g && g == b {
-        format!("{}", num(r))
+        num(r)
     } else {
         format!("({}, {}, {})", num(r), num(g), num(b))
     }
