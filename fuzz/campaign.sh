@@ -14,7 +14,8 @@ i=0
 while [ "$i" -lt "$batches" ]; do
     i=$((i + 1))
     echo "== batch $i ($(date -u +%H:%M:%S))"
-    ( ulimit -v 8000000; RUST_BACKTRACE=0 SNEE_FUZZ_CASES=$per nice -n 19 "$bin" mutated_ --nocapture --test-threads 1 ) 2>&1 \
+    ( ulimit -v 8000000; RUST_BACKTRACE=0 RAYON_NUM_THREADS=1 SNEE_FUZZ_DIR=/dev/shm/snee-fuzz-$$ SNEE_FUZZ_CASES=$per nice -n 19 "$bin" mutated_ --nocapture --test-threads 1 ) 2>&1 \
         | grep -E "cases run|minimal failing|input saved in|^thread .* panicked|^(panic|hang|image error|parse error|build error|non-finite)|test result|memory allocation|signal" \
         || echo "batch $i: no output (rc $?)"
 done
+rm -rf /dev/shm/snee-fuzz-$$
