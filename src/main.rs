@@ -45,7 +45,7 @@ enum Command {
         #[arg(short = 'D', value_name = "NAME=VALUE")]
         define: Vec<String>,
         /// Samples per pixel (default: the scene's sampler sample_count).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true, value_parser = positive_spp)]
         spp: Option<u32>,
         #[arg(long, default_value_t = 0)]
         seed: u64,
@@ -125,6 +125,15 @@ fn parse_defines(defs: &[String]) -> anyhow::Result<Vec<(String, String)>> {
             Ok((k.to_string(), v.to_string()))
         })
         .collect()
+}
+
+/// `--spp`: a whole number of samples per pixel, at least 1 (0 would write a black image).
+fn positive_spp(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<i64>() {
+        Ok(n) if (1..=u32::MAX as i64).contains(&n) => Ok(n as u32),
+        Ok(n) => Err(format!("--spp must be between 1 and {}, got {n}", u32::MAX)),
+        Err(_) => Err(format!("--spp expects a whole number of samples per pixel, got \"{s}\"")),
+    }
 }
 
 fn main() -> ExitCode {

@@ -80,6 +80,7 @@ impl EnvironmentEmitter {
             .ok_or_else(|| props.error("filename", "envmap requires the string property \"filename\""))?;
         let pos = props.pos_of("filename");
         let path = resolver.resolve_at(&filename, &pos)?;
+        crate::scene::limits::check_image(&path, "filename", &pos)?;
         let bitmap = read_image(&path, true).map_err(|e| Error::at(&pos, e.to_string()))?;
         let file = path.display().to_string();
         let pixels = bitmap.to_rgb_pixels(&file).map_err(|e| Error::at(&pos, e.to_string()))?;

@@ -100,6 +100,8 @@ impl Bitmap {
 /// `srgb_to_linear` linearises the colour channels of 8/16-bit data; float formats are linear already.
 pub fn read_image(path: &Path, srgb_to_linear: bool) -> Result<Bitmap> {
     let file = path.display().to_string();
+    // Decoders allocate what the header declares: refuse sizes beyond memory first.
+    crate::scene::limits::check_image(path, "", &crate::scene::SrcPos::file_only(&file))?;
     let bytes = std::fs::read(path).map_err(|e| Error::in_file(&file, format!("cannot read image: {e}")))?;
     let bitmap = if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
         read_exr(&bytes, &file)?

@@ -274,6 +274,16 @@ impl Builder<'_> {
         props.finish()?;
         let shape =
             Shape { geometry, plugin: obj.plugin.clone(), id: obj.id.clone(), bsdf, emitter, interior, exterior };
+        // Beyond ±1e18, products of two extents (areas, BVH costs) overflow f32 (found by fuzzing).
+        let b = shape.bounds();
+        let reach = b.min.abs().max(b.max.abs()).max_element();
+        if !b.is_empty() && !(reach <= 1e18) {
+            let msg = format!(
+                "shape \"{}\" reaches {reach:e} in world space; coordinates must stay within ±1e18",
+                obj.plugin
+            );
+            return Err(Error::at(&obj.pos, msg));
+        }
         if let Some(s) = sensor_desc {
             if let Some((_, first)) = &self.meter {
                 return Err(Error::at(&s.pos, format!("only one sensor is supported (the first is at {})", first)));

@@ -3,6 +3,7 @@
 pub mod build;
 pub mod desc;
 pub mod error;
+pub mod limits;
 pub mod resolver;
 pub mod world;
 pub mod xml;

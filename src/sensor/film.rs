@@ -31,6 +31,7 @@ use super::image_block::ImageBlock;
 use super::rfilter::RFilter;
 use crate::scene::desc::{ObjectDesc, PluginKind, Props};
 use crate::scene::error::{Error, Result};
+use crate::scene::limits;
 
 /// Largest accepted film side, to turn typos into errors instead of huge allocations.
 const MAX_FILM_SIDE: i64 = 1 << 16;
@@ -175,6 +176,9 @@ impl Film {
             Some(f) => RFilter::from_desc(&f)?,
             None => RFilter::default(),
         };
+        let pixels = crop_width as u64 * crop_height as u64;
+        let what = format!("the film (width x height {width} x {height}, crop {crop_width} x {crop_height})");
+        limits::check(limits::film_bytes(pixels, pixel_format.channel_count() as u64), &what, &props.pos_of("width"))?;
         props.finish()?;
         Ok(Film {
             width,

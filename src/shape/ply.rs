@@ -58,6 +58,17 @@ pub fn load_ply_with(path: &Path, flip_tex_coords: bool) -> Result<MeshData> {
 pub fn load_ply_from_bytes(bytes: &[u8], file: &str, flip_tex_coords: bool) -> Result<MeshData> {
     let header = parse_header(bytes, file)?;
     let plan = Plan::new(&header, file)?;
+    // Refuse declared counts that cannot fit in memory (faces counted as one triangle each),
+    // when the body can hold them (at least a byte per value); otherwise decoding reports the truncation.
+    let declared = |name: &str| header.elements.iter().find(|e| e.name == name).map(|e| (e.count, e.line));
+    let min_body =
+        header.elements.iter().map(|e| e.count.saturating_mul(e.props.len() as u64)).fold(0, u64::saturating_add);
+    if let (Some((vertices, line)), true) = (declared("vertex"), min_body <= bytes.len() as u64) {
+        let faces = declared("face").map_or(0, |f| f.0);
+        let what = format!("element vertex {vertices} (with {faces} faces)");
+        let needed = crate::scene::limits::mesh_bytes(vertices, faces);
+        crate::scene::limits::check(needed, &what, &SrcPos::new(file, line, 1))?;
+    }
     let body = bytes.get(header.body_start..).unwrap_or(&[]);
     let mut mesh = match header.format {
         Format::Ascii => {

@@ -33,7 +33,7 @@ use flate2::read::ZlibDecoder;
 
 use super::mesh_data::{normalize_normal, MeshData};
 use crate::math::{Vec2, Vec3};
-use crate::scene::error::{Error, Result};
+use crate::scene::error::{Error, Result, SrcPos};
 
 const FORMAT_ID: u16 = 0x041C;
 const HAS_NORMALS: u32 = 0x0001;
@@ -246,6 +246,14 @@ impl Stream<'_> {
         };
         let nv = u32::try_from(vertex_count).map_err(|_| too_many(vertex_count, "vertices"))? as usize;
         let nt = u32::try_from(triangle_count).map_err(|_| too_many(triangle_count, "triangles"))? as usize;
+        // Refuse what cannot fit in memory, when the compressed data left (zlib expands at most
+        // 1032:1) can hold the declared counts; otherwise reading reports the truncation.
+        let declared = (nv as u64 + nt as u64) * 12;
+        if declared / 1032 <= self.z.get_ref().len() as u64 {
+            let what = format!("mesh {} ({nv} vertices, {nt} triangles)", self.shape);
+            let needed = crate::scene::limits::mesh_bytes(nv as u64, nt as u64);
+            crate::scene::limits::check(needed, &what, &SrcPos::file_only(self.file))?;
+        }
         let double = flags & DOUBLE_PRECISION != 0;
 
         let p = self.floats(3 * nv, double, "vertex positions")?;

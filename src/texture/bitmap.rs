@@ -133,6 +133,7 @@ impl BitmapTexture {
 
         let pos = props.pos_of("filename");
         let path = resolver.resolve_at(&filename, &pos)?;
+        crate::scene::limits::check_image(&path, "filename", &pos)?;
         let bitmap = read_image(&path, !raw).map_err(|e| Error::at(&pos, e.to_string()))?;
         let file = path.display().to_string();
         let pixels = bitmap.to_rgb_pixels(&file).map_err(|e| Error::at(&pos, e.to_string()))?;
