@@ -133,12 +133,17 @@ impl Bvh8 {
         let mut packet = TriPacket4::EMPTY;
         let mut lanes = [u32::MAX; LEAF_SIZE];
         let mut lane = 0;
-        let mut stack = vec![n];
-        while let Some(k) = stack.pop() {
-            let node = &bvh2.nodes[k];
+        // A subtree of at most LEAF_SIZE primitives has fewer than 2 · LEAF_SIZE nodes.
+        let mut stack = [0usize; 2 * LEAF_SIZE];
+        let mut sp = 1;
+        stack[0] = n;
+        while sp > 0 {
+            sp -= 1;
+            let node = &bvh2.nodes[stack[sp]];
             if node.prim_count == 0 {
-                stack.push(node.first_index as usize);
-                stack.push(node.first_index as usize + 1);
+                stack[sp] = node.first_index as usize;
+                stack[sp + 1] = node.first_index as usize + 1;
+                sp += 2;
                 continue;
             }
             assert!(lane + node.prim_count as usize <= LEAF_SIZE, "BVH leaf larger than a packet");
