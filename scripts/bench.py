@@ -137,6 +137,10 @@ def run_mitsuba(args, mi, variant, scene_path, out_dir):
         dt = time.perf_counter() - t0
         if seconds is None or dt < seconds:
             seconds, img = dt, im
+    if args.threads_now:
+        # Writing an EXR with Dr.Jit's pool at one thread deadlocks (Mitsuba 3.9.1): restore it first.
+        import drjit as dr
+        dr.set_thread_count(os.cpu_count())
     exr = os.path.join(out_dir, "mitsuba.exr")
     mi.Bitmap(img[..., :3].astype(np.float32)).write(exr)
     return dict(seconds=seconds, warmup_seconds=warmup, spp=args.spp, variant=variant,
@@ -321,4 +325,5 @@ def main():
 
 
 if __name__ == "__main__":
+    sys.stdout.reconfigure(line_buffering=True)
     main()
