@@ -122,10 +122,12 @@ def mitsuba_render(mi, scene, spp, seed):
 
 
 def run_mitsuba(args, mi, variant, scene_path, out_dir):
+    scene = mi.load_file(scene_path, **{k: v for k, v in args.mitsuba_defines})
     if args.threads_now:
+        # Only around the renders: Mitsuba 3.9.1 deadlocks reading or writing EXR files with
+        # Dr.Jit's pool at one thread.
         import drjit as dr
         dr.set_thread_count(args.threads_now)
-    scene = mi.load_file(scene_path, **{k: v for k, v in args.mitsuba_defines})
     w, h = scene.sensors()[0].film().crop_size()
     t0 = time.perf_counter()
     mitsuba_render(mi, scene, min(args.spp, max(1, MAX_SAMPLES_PER_PASS // (w * h))), seed=1)
@@ -138,7 +140,6 @@ def run_mitsuba(args, mi, variant, scene_path, out_dir):
         if seconds is None or dt < seconds:
             seconds, img = dt, im
     if args.threads_now:
-        # Writing an EXR with Dr.Jit's pool at one thread deadlocks (Mitsuba 3.9.1): restore it first.
         import drjit as dr
         dr.set_thread_count(os.cpu_count())
     exr = os.path.join(out_dir, "mitsuba.exr")

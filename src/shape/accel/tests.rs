@@ -33,7 +33,7 @@ fn random_ray(s: &mut Sampler, i: usize, spread: f32) -> Ray {
         1 => d = Vec3::new(-0.0, d.y.signum(), -0.0),
         _ => {}
     }
-    Ray { o, d, tmax: if i % 3 == 0 { f32::INFINITY } else { 1.0 + spread * s.next_1d() } }
+    Ray { o, d, tmax: if i.is_multiple_of(3) { f32::INFINITY } else { 1.0 + spread * s.next_1d() } }
 }
 
 /// Nearest hit over all triangles, one at a time.

@@ -216,10 +216,10 @@ mod tests {
                 p.set(l, *t);
             }
             let (mask, t, b1, b2) = WatertightRay::new(ray.o, ray.d).intersect4(&p, ray.tmax);
-            for l in 0..4 {
-                let want = if l < lanes { woop_scalar(&ray, tris[l], ray.tmax) } else { None };
+            for (l, tri) in tris.iter().enumerate() {
+                let want = if l < lanes { woop_scalar(&ray, *tri, ray.tmax) } else { None };
                 let got = (mask & (1 << l) != 0).then(|| (t.to_array()[l], b1.to_array()[l], b2.to_array()[l]));
-                assert_eq!(got, want, "lane {l} ray {ray:?} triangle {:?}", tris[l]);
+                assert_eq!(got, want, "lane {l} ray {ray:?} triangle {tri:?}");
                 n += 1;
                 hits += got.is_some() as u32;
             }
