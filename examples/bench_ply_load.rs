@@ -1,7 +1,8 @@
 //! Benchmark of the PLY loader: writes a binary little-endian PLY grid with about 1M triangles to
 //! a temporary file, times `load_ply` (best of 3) and prints the time and the bytes per triangle of
 //! the file and of the resulting `MeshData`. With `--compare`, also times ply-rs-bw's generic
-//! parser on the same file once (why the loader has its own body decoder).
+//! parser on the same file once (why the loader has its own body decoder). For the xyz file it
+//! also times the world-space mesh and the BVH build, with the BVH's bytes per triangle.
 //!
 //! ```text
 //! cargo run --release --example bench_ply_load [-- --triangles 1000000] [--compare]
@@ -92,8 +93,41 @@ fn main() {
         if compare {
             compare_ply_rs(&path);
         }
+        if !normals_and_uvs {
+            bvh_build(m);
+        }
         std::fs::remove_file(&path).ok();
     }
+}
+
+/// Time the scene-side work for the mesh: world-space mesh (area table, normals) and the BVH.
+fn bvh_build(m: snee::shape::mesh_data::MeshData) {
+    use snee::shape::{accel::Accel, Geometry, Mesh, Shape};
+    let t0 = Instant::now();
+    let mesh = Mesh::new(m, &snee::math::Mat4::IDENTITY, false, false);
+    let t1 = Instant::now();
+    let shape = Shape {
+        geometry: Geometry::Mesh(mesh),
+        plugin: "ply".into(),
+        id: None,
+        bsdf: 0,
+        emitter: None,
+        interior: None,
+        exterior: None,
+    };
+    let shapes = [shape];
+    let accel = Accel::build(&shapes);
+    let t2 = Instant::now();
+    let (nodes, packets, depth) = accel.stats();
+    let nt = shapes[0].triangle_count() as f64;
+    println!(
+        "{:>20}  Mesh::new {:.1} ms, BVH build {:.1} ms ({nodes} nodes, {packets} leaf packets, depth {depth}, \
+         {:.1} B/triangle)",
+        "",
+        (t1 - t0).as_secs_f64() * 1e3,
+        (t2 - t1).as_secs_f64() * 1e3,
+        accel.memory_bytes() as f64 / nt
+    );
 }
 
 fn compare_ply_rs(path: &Path) {

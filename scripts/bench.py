@@ -20,8 +20,18 @@ scene compiles its own kernels) and a Markdown table of all of them is printed a
 `--repeat K` renders each scene K times with both renderers and keeps the fastest run of each
 (the machine is shared; the minimum is the least disturbed measurement).
 
+Suite (`--suite`, the default without scene arguments): the speed table of the README in one run:
+cornell_box, glass_envmap, media_null, media_rough_glass and the paper statue (sphere light, smooth
+boundary, sigma_t 2 and 34) with `volpath`, plus the statue with snee's `volpath_snee` (timed against
+Mitsuba's `volpath`, which has no SNEE), each at 1 and 2 threads (`--threads`), with per-scene sample
+counts (`SUITE`, scaled by `--spp-scale`); then the traversal benchmark
+(`cargo run --release --example bench_traversal`): closest-hit and shadow M rays/s on one thread, bytes
+per triangle, and, when valgrind is installed, instructions per ray (callgrind, 10,000 rays).
+Timings on a shared machine are noisy: use `--repeat` and compare ratios measured in the same run.
+
 Usage:
-  python3 scripts/bench.py                                  # scenes/default.xml at 64 spp
+  python3 scripts/bench.py                                  # the suite (about 5 minutes)
+  python3 scripts/bench.py scenes/default.xml --spp 64      # one scene, every core
   python3 scripts/bench.py scenes/cornell_box.xml scenes/glass_envmap.xml --spp 256 \
       --snee target/release/snee --repeat 3                 # several scenes, one table
   python3 scripts/bench.py scenes/cornell_box.xml --spp 256
@@ -54,7 +64,11 @@ def run_snee(args, scene, out_dir):
         print("building snee (cargo build --release, not timed) ...", flush=True)
         subprocess.run(["cargo", "build", "--release"], cwd=ROOT, check=True)
         cmd = ["cargo", "run", "--release", "--quiet", "--"]
-    cmd += ["render", scene, "-o", exr, "--spp", str(args.spp), "--stats", stats_path]
+    cmd += ["render", scene, "-o", exr, "--spp", str(args.spp), "--stats", stats_path, "-q"]
+    if args.threads_now:
+        cmd += ["--threads", str(args.threads_now)]
+    for name, value in args.defines:
+        cmd += ["-D", f"{name}={value}"]
     print("running:", " ".join(shlex.quote(c) for c in cmd), flush=True)
     best = None
     for _ in range(args.repeat):
@@ -108,7 +122,12 @@ def mitsuba_render(mi, scene, spp, seed):
 
 
 def run_mitsuba(args, mi, variant, scene_path, out_dir):
-    scene = mi.load_file(scene_path)
+    scene = mi.load_file(scene_path, **{k: v for k, v in args.mitsuba_defines})
+    if args.threads_now:
+        # Only around the renders: Mitsuba 3.9.1 deadlocks reading or writing EXR files with
+        # Dr.Jit's pool at one thread.
+        import drjit as dr
+        dr.set_thread_count(args.threads_now)
     w, h = scene.sensors()[0].film().crop_size()
     t0 = time.perf_counter()
     mitsuba_render(mi, scene, min(args.spp, max(1, MAX_SAMPLES_PER_PASS // (w * h))), seed=1)
@@ -120,6 +139,9 @@ def run_mitsuba(args, mi, variant, scene_path, out_dir):
         dt = time.perf_counter() - t0
         if seconds is None or dt < seconds:
             seconds, img = dt, im
+    if args.threads_now:
+        import drjit as dr
+        dr.set_thread_count(os.cpu_count())
     exr = os.path.join(out_dir, "mitsuba.exr")
     mi.Bitmap(img[..., :3].astype(np.float32)).write(exr)
     return dict(seconds=seconds, warmup_seconds=warmup, spp=args.spp, variant=variant,
@@ -136,7 +158,10 @@ def mean_rgb(mi, path):
 
 
 def bench_scene(args, mi, variant, scene):
-    out_dir = os.path.abspath(os.path.join(args.out, os.path.splitext(os.path.basename(scene))[0]))
+    tag = os.path.splitext(os.path.basename(scene))[0] + "".join(f"_{v}" for _, v in args.defines)
+    if args.threads_now:
+        tag += f"_t{args.threads_now}"
+    out_dir = os.path.abspath(os.path.join(args.out, tag))
     os.makedirs(out_dir, exist_ok=True)
 
     snee = None if args.skip_snee else run_snee(args, scene, out_dir)
@@ -150,7 +175,8 @@ def bench_scene(args, mi, variant, scene):
     print(f"  {'mitsuba':8s} {mits['seconds']:9.3f} {mits['samples_per_second'] / 1e6:11.3f}  "
           f"{np.round(m_mean, 4).tolist()}  ({mits['variant']}, JIT warm-up "
           f"{mits['warmup_seconds']:.2f} s excluded)")
-    result = dict(scene=os.path.relpath(scene, ROOT), spp=args.spp, repeat=args.repeat, mitsuba=mits)
+    result = dict(scene=os.path.relpath(scene, ROOT), spp=args.spp, repeat=args.repeat, mitsuba=mits,
+                  threads=args.threads_now, defines=dict(args.defines))
     if snee is not None:
         s_mean = mean_rgb(mi, snee["image"])
         print(f"  {'snee':8s} {snee['seconds']:9.3f} {snee['samples_per_second'] / 1e6:11.3f}  "
@@ -169,25 +195,89 @@ def bench_scene(args, mi, variant, scene):
 
 
 def print_table(results):
-    print("\n| scene | size | spp | snee render s | snee process s | Mitsuba s | Mitsuba JIT warm-up s "
-          "(excluded) | snee / Mitsuba |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("\n| scene | integrator (snee) | threads | size | spp | snee render s | snee Msamples/s | "
+          "snee process s | Mitsuba s | Mitsuba Msamples/s | Mitsuba JIT warm-up s (excluded) | snee / Mitsuba |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in results:
         m = r["mitsuba"]
         s = r.get("snee")
-        cells = [os.path.splitext(os.path.basename(r["scene"]))[0], f"{m['width']}x{m['height']}",
-                 str(r["spp"]),
-                 f"{s['seconds']:.2f}" if s else "-", f"{s['wall_seconds']:.2f}" if s else "-",
-                 f"{m['seconds']:.2f}", f"{m['warmup_seconds']:.2f}",
+        cells = [os.path.splitext(os.path.basename(r["scene"]))[0], r["defines"].get("integrator", "(scene's)"),
+                 str(r["threads"] or "all"), f"{m['width']}x{m['height']}", str(r["spp"]),
+                 f"{s['seconds']:.2f}" if s else "-", f"{s['samples_per_second'] / 1e6:.3f}" if s else "-",
+                 f"{s['wall_seconds']:.2f}" if s else "-",
+                 f"{m['seconds']:.2f}", f"{m['samples_per_second'] / 1e6:.3f}", f"{m['warmup_seconds']:.2f}",
                  f"{r['ratio_seconds']:.2f}" if s else "-"]
         print("| " + " | ".join(cells) + " |")
+
+
+# (scene, snee integrator override or None, spp): the README's speed table.
+SUITE = [
+    ("scenes/cornell_box.xml", None, 64),
+    ("scenes/glass_envmap.xml", None, 32),
+    ("scenes/media_null.xml", None, 64),
+    ("scenes/media_rough_glass.xml", None, 64),
+    ("scenes/paper/sphere_smooth_st02.xml", "volpath", 16),
+    ("scenes/paper/sphere_smooth_st02.xml", "volpath_snee", 16),
+    ("scenes/paper/sphere_smooth_st34.xml", "volpath", 8),
+    ("scenes/paper/sphere_smooth_st34.xml", "volpath_snee", 8),
+]
+TRAVERSAL_SCENES = ["scenes/cornell_box.xml", "scenes/paper/sphere_smooth_st02.xml"]
+
+
+def callgrind_instructions(binary, scene, function, rays):
+    """Instructions executed inside `function` per ray (valgrind's callgrind), or None."""
+    out = os.path.join(ROOT, "out", "bench", "callgrind.out")
+    cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", f"--toggle-collect={function}",
+           binary, scene, "--rays", str(rays), "--reps", "1"]
+    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    if proc.returncode != 0 or not os.path.exists(out):
+        return None
+    with open(out) as fh:
+        for line in fh:
+            if line.startswith(("summary:", "totals:")):
+                return int(line.split()[1]) / rays
+    return None
+
+
+def run_traversal(args):
+    """The traversal benchmark: M rays/s (one thread) and, with valgrind, instructions per ray."""
+    print("\nbuilding the traversal benchmark (not timed) ...", flush=True)
+    subprocess.run(["cargo", "build", "--release", "--example", "bench_traversal"], cwd=ROOT, check=True)
+    binary = os.path.join(ROOT, "target", "release", "examples", "bench_traversal")
+    scenes = [os.path.join(ROOT, s) for s in TRAVERSAL_SCENES]
+    proc = subprocess.run([binary, *scenes, "--json"], cwd=ROOT, capture_output=True, text=True, check=True)
+    rows = json.loads(proc.stdout)
+    have_valgrind = not args.no_callgrind and subprocess.run(["which", "valgrind"], capture_output=True).returncode == 0
+    for row in rows:
+        row["closest_instructions_per_ray"] = row["shadow_instructions_per_ray"] = None
+        if have_valgrind:
+            row["closest_instructions_per_ray"] = callgrind_instructions(
+                binary, row["scene"], "snee::shape::accel::Accel::intersect", 10000)
+            row["shadow_instructions_per_ray"] = callgrind_instructions(
+                binary, row["scene"], "snee::shape::accel::Accel::occluded", 10000)
+    print("\n| scene | triangles | BVH bytes / triangle | load + build s | closest Mrays/s | shadow Mrays/s | "
+          "instructions / closest ray | instructions / shadow ray |")
+    print("|---|---|---|---|---|---|---|---|")
+    fmt = lambda v: "-" if v is None else f"{v:.0f}"  # noqa: E731
+    for r in rows:
+        print(f"| {os.path.relpath(r['scene'], ROOT)} | {r['triangles']} | {r['bytes_per_triangle']:.1f} | "
+              f"{r['load_s']:.3f} | {r['closest_mrays']:.2f} | {r['shadow_mrays']:.2f} | "
+              f"{fmt(r['closest_instructions_per_ray'])} | {fmt(r['shadow_instructions_per_ray'])} |")
+    return rows
 
 
 def main():
     ap = argparse.ArgumentParser(description="Time snee vs Mitsuba 3 (same scene, resolution, spp).",
                                  epilog="Mitsuba's LLVM JIT compile time is excluded (warm-up run).")
-    ap.add_argument("scenes", nargs="*", default=[os.path.join(ROOT, "scenes", "default.xml")],
-                    help="scene files (default: scenes/default.xml)")
+    ap.add_argument("scenes", nargs="*", help="scene files (default: the suite)")
+    ap.add_argument("--suite", action="store_true", help="the README's speed table (default without scenes)")
+    ap.add_argument("--threads", default=None,
+                    help="comma-separated thread counts for both renderers (suite default: 1,2; else all cores)")
+    ap.add_argument("--spp-scale", type=float, default=1.0, help="multiply the suite's sample counts")
+    ap.add_argument("-D", dest="define", action="append", default=[], metavar="NAME=VALUE",
+                    help="scene parameter for both renderers (e.g. integrator=volpath)")
+    ap.add_argument("--no-traversal", action="store_true", help="skip the traversal benchmark")
+    ap.add_argument("--no-callgrind", action="store_true", help="skip the instruction counts")
     ap.add_argument("--spp", type=int, default=64, help="samples per pixel (default 64)")
     ap.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variant (default llvm_ad_rgb)")
     ap.add_argument("--snee", default=None,
@@ -201,15 +291,40 @@ def main():
     if args.repeat < 1:
         ap.error("--repeat must be at least 1")
 
+    suite = args.suite or not args.scenes
+    threads = [int(t) for t in (args.threads or ("1,2" if suite else "0")).split(",")]
+    if suite:
+        jobs = [(os.path.join(ROOT, sc), integ, max(1, round(spp * args.spp_scale))) for sc, integ, spp in SUITE]
+    else:
+        jobs = [(os.path.abspath(sc), None, args.spp) for sc in args.scenes]
+    if args.snee is None:
+        print("building snee (cargo build --release, not timed) ...", flush=True)
+        subprocess.run(["cargo", "build", "--release"], cwd=ROOT, check=True)
+        args.snee = os.path.join(ROOT, "target", "release", "snee")
     mi, variant = setup_mitsuba(args.variant)
-    results = [bench_scene(args, mi, variant, os.path.abspath(sc)) for sc in args.scenes]
+    base_defines = [tuple(d.split("=", 1)) for d in args.define]
+    results = []
+    for scene, integrator, spp in jobs:
+        for t in threads:
+            args.threads_now = t or None
+            args.spp = spp
+            args.defines = base_defines + ([("integrator", integrator)] if integrator else [])
+            # Mitsuba has no volpath_snee: it renders the scene's volpath for comparison.
+            args.mitsuba_defines = [(k, v) for k, v in args.defines if not (k == "integrator" and v == "volpath_snee")]
+            args.mitsuba_defines += [("integrator", "volpath")] if integrator == "volpath_snee" else []
+            results.append(bench_scene(args, mi, variant, scene))
     print_table(results)
+    summary = dict(results=results)
+    if suite and not args.no_traversal:
+        summary["traversal"] = run_traversal(args)
+    print(f"\n(machine: {os.cpu_count()} logical CPUs, shared with other jobs: timings are noisy)")
     path = os.path.join(os.path.abspath(args.out), "bench_summary.json")
     with open(path, "w") as fh:
-        json.dump(results, fh, indent=2, default=str)
+        json.dump(summary, fh, indent=2, default=str)
         fh.write("\n")
     print(f"wrote {path}")
 
 
 if __name__ == "__main__":
+    sys.stdout.reconfigure(line_buffering=True)
     main()

@@ -1,0 +1,127 @@
+use super::triangle::{TriPacket4, WatertightRay};
+use super::*;
+use crate::math::{warp, Vec3};
+use crate::sampler::Sampler;
+
+fn soup(seed: u64, count: u32, spread: f32) -> Vec<Shape> {
+    let mut s = Sampler::new(seed, 0);
+    let mut data = crate::shape::mesh_data::MeshData::default();
+    for i in 0..count {
+        let c = Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) * spread;
+        for _ in 0..3 {
+            data.positions.push(c + Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) * 0.5);
+        }
+        data.indices.push([3 * i, 3 * i + 1, 3 * i + 2]);
+    }
+    let mesh = crate::shape::Mesh::new(data, &crate::math::Mat4::IDENTITY, true, false);
+    vec![Shape {
+        geometry: Geometry::Mesh(mesh),
+        plugin: "ply".into(),
+        id: None,
+        bsdf: 0,
+        emitter: None,
+        interior: None,
+        exterior: None,
+    }]
+}
+
+fn random_ray(s: &mut Sampler, i: usize, spread: f32) -> Ray {
+    let o = Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) * (spread + 4.0) - 2.0;
+    let mut d = warp::square_to_uniform_sphere(s.next_2d());
+    match i % 6 {
+        0 => d = Vec3::new(d.x, 0.0, d.z).normalize(),
+        1 => d = Vec3::new(-0.0, d.y.signum(), -0.0),
+        _ => {}
+    }
+    Ray { o, d, tmax: if i.is_multiple_of(3) { f32::INFINITY } else { 1.0 + spread * s.next_1d() } }
+}
+
+/// Nearest hit over all triangles, one at a time.
+fn brute_force(shapes: &[Shape], ray: &Ray) -> Option<(u32, f32)> {
+    let Geometry::Mesh(m) = &shapes[0].geometry else { unreachable!() };
+    let wt = WatertightRay::new(ray.o, ray.d);
+    let mut best: Option<(u32, f32)> = None;
+    for p in 0..m.triangle_count() as u32 {
+        let mut packet = TriPacket4::EMPTY;
+        packet.set(0, m.vertices(p));
+        if let Some((_, t, _, _)) = wt.nearest4(&packet, best.map_or(ray.tmax, |b| b.1)) {
+            best = Some((p, t));
+        }
+    }
+    best
+}
+
+/// Both node tests give the same masks and entry distances on every node.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn avx_node_test_equals_portable() {
+    if Isa::detect() != Isa::Avx2 {
+        return;
+    }
+    let shapes = soup(11, 3000, 10.0);
+    let accel = Accel::build(&shapes);
+    let bvh = accel.bvh.as_ref().unwrap();
+    assert!(bvh.nodes.len() > 50);
+    let mut s = Sampler::new(12, 0);
+    for i in 0..300 {
+        let r = random_ray(&mut s, i, 10.0);
+        let nr = traverse::NodeRay::new(r.o, r.d);
+        for node in &bvh.nodes {
+            let (mut a, mut b) = ([0.0; 8], [0.0; 8]);
+            let ma = traverse::node_test_portable(node, &nr, r.tmax, &mut a);
+            // SAFETY: AVX2 support checked above.
+            let mb = unsafe { traverse::node_test_avx(node, &nr, r.tmax, &mut b) };
+            assert_eq!(ma, mb);
+            for k in 0..8 {
+                if ma & (1 << k) != 0 {
+                    assert_eq!(a[k].to_bits(), b[k].to_bits());
+                }
+            }
+        }
+    }
+}
+
+/// Closest hit and occlusion through the BVH equal brute force over all triangles (same
+/// distance bit for bit), with either node test, for dense and sparse soups and a tiny mesh.
+#[test]
+fn traversal_equals_brute_force() {
+    for (seed, count, spread) in [(1, 2000, 10.0), (2, 500, 40.0), (3, 3, 1.0), (4, 40, 3.0)] {
+        let shapes = soup(seed, count, spread);
+        for isa in [Isa::Portable, Isa::detect()] {
+            let accel = Accel::build_with(&shapes, BvhBuildParams::medium_build(), isa);
+            let mut s = Sampler::new(seed + 100, 0);
+            let mut hits = 0;
+            for i in 0..3000 {
+                let mut r = random_ray(&mut s, i, spread);
+                if i % 2 == 0 {
+                    // Aim at a vertex, an edge point or an interior point of a random triangle.
+                    let Geometry::Mesh(m) = &shapes[0].geometry else { unreachable!() };
+                    let v = m.vertices(((s.next_1d() * count as f32) as u32).min(count - 1));
+                    let target = match i % 6 {
+                        0 => v[(i / 6) % 3],
+                        2 => v[0] + (v[1] - v[0]) * s.next_1d(),
+                        _ => v[0] * 0.2 + v[1] * 0.3 + v[2] * 0.5,
+                    };
+                    r.d = (target - r.o).normalize();
+                    r.tmax = f32::INFINITY;
+                }
+                let want = brute_force(&shapes, &r);
+                let got = accel.intersect(&shapes, &r);
+                assert_eq!(got.map(|h| h.t), want.map(|w| w.1), "ray {r:?}");
+                if let (Some(g), Some(w)) = (got, want) {
+                    // Same triangle unless two are hit at exactly the same distance.
+                    if g.prim != w.0 {
+                        let Geometry::Mesh(m) = &shapes[0].geometry else { unreachable!() };
+                        let mut p = TriPacket4::EMPTY;
+                        p.set(0, m.vertices(g.prim));
+                        let t = WatertightRay::new(r.o, r.d).nearest4(&p, f32::INFINITY).map(|x| x.1);
+                        assert_eq!(t, Some(w.1));
+                    }
+                    hits += 1;
+                }
+                assert_eq!(accel.occluded(&shapes, &r), want.is_some(), "ray {r:?}");
+            }
+            assert!(hits > 100, "only {hits} hits");
+        }
+    }
+}

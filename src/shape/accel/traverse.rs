@@ -1,0 +1,270 @@
+//! Traversal of the 8-wide BVH: closest hit (children visited nearest first, farther ones culled
+//! once a hit is closer) and any hit (stops at the first blocker).
+//!
+//! The node test is the slab test on all eight children at once: one AVX2 instruction per plane
+//! when the CPU has AVX2 (detected at run time), two SSE halves otherwise, with the same float
+//! operations and so the same hit masks. It is conservative: the far distance of each box is
+//! enlarged by 1 + 2γ₃ (Ize 2013, "Robust BVH Ray Traversal", JCGT 2(2)), so rounding never
+//! culls a box the ray touches, and a zero direction component gives a finite inverse (no NaN
+//! from 0 · ∞).
+
+use super::bvh8::{Bvh8, Node8, EMPTY, LEAF};
+use super::triangle::WatertightRay;
+use crate::math::{Ray, Vec3};
+use glam::Vec4;
+use std::mem::MaybeUninit;
+
+/// 1 + 2γ₃ rounded up, γ_n = n·ε / (1 − n·ε), ε = 2⁻²⁴ (Ize 2013, Sec. 3).
+const FAR_SCALE: f32 = 1.000_000_4;
+
+/// The ray as the node test needs it.
+#[derive(Clone, Copy, Debug)]
+pub struct NodeRay {
+    pub o: [f32; 3],
+    pub inv_d: [f32; 3],
+    /// Row of `Node8::bounds` holding the near (entry) plane per axis, and the far one.
+    pub near: [usize; 3],
+    pub far: [usize; 3],
+}
+
+impl NodeRay {
+    #[inline(always)]
+    pub fn new(o: Vec3, d: Vec3) -> NodeRay {
+        // −0.0 → +0.0, so that the sign test and the inverse agree.
+        let d = d + Vec3::ZERO;
+        let inv = |x: f32| {
+            let i = 1.0 / x;
+            if i.is_finite() {
+                i
+            } else {
+                f32::MAX.copysign(x)
+            }
+        };
+        let row = |axis: usize, neg: bool| 2 * axis + neg as usize;
+        let neg = [d.x < 0.0, d.y < 0.0, d.z < 0.0];
+        NodeRay {
+            o: o.to_array(),
+            inv_d: [inv(d.x), inv(d.y), inv(d.z)],
+            near: [row(0, neg[0]), row(1, neg[1]), row(2, neg[2])],
+            far: [row(0, !neg[0]), row(1, !neg[1]), row(2, !neg[2])],
+        }
+    }
+}
+
+/// Slab test on the eight children, portable version (two SSE halves on x86-64): hit mask, and
+/// each child's entry distance in `t_near`.
+#[inline(always)]
+pub fn node_test_portable(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f32; 8]) -> u32 {
+    let mut mask = 0;
+    for h in 0..2 {
+        let row = |i: usize| Vec4::from_slice(&node.bounds[i][4 * h..4 * h + 4]);
+        let slab = |a: usize| {
+            let (o, inv) = (Vec4::splat(r.o[a]), Vec4::splat(r.inv_d[a]));
+            ((row(r.near[a]) - o) * inv, (row(r.far[a]) - o) * inv)
+        };
+        let (nx, fx) = slab(0);
+        let (ny, fy) = slab(1);
+        let (nz, fz) = slab(2);
+        let tn = nx.max(ny).max(nz.max(Vec4::ZERO));
+        let tf = (fx.min(fy).min(fz) * Vec4::splat(FAR_SCALE)).min(Vec4::splat(tmax));
+        mask |= tn.cmple(tf).bitmask() << (4 * h);
+        tn.write_to_slice(&mut t_near[4 * h..4 * h + 4]);
+    }
+    mask
+}
+
+/// The same slab test in one AVX register per plane (a macro so that it inlines into the AVX2
+/// traversal; see `node_test_avx` for a callable version).
+#[cfg(target_arch = "x86_64")]
+macro_rules! node_test_avx_body {
+    ($node:expr, $r:expr, $tmax:expr, $t_near:expr) => {{
+        use std::arch::x86_64::*;
+        let (node, r, tmax, t_near): (&Node8, &NodeRay, f32, &mut [f32; 8]) = ($node, $r, $tmax, $t_near);
+        macro_rules! slab {
+            ($a:expr) => {{
+                let o = _mm256_set1_ps(r.o[$a]);
+                let inv = _mm256_set1_ps(r.inv_d[$a]);
+                let near = _mm256_loadu_ps(node.bounds[r.near[$a]].as_ptr());
+                let far = _mm256_loadu_ps(node.bounds[r.far[$a]].as_ptr());
+                (_mm256_mul_ps(_mm256_sub_ps(near, o), inv), _mm256_mul_ps(_mm256_sub_ps(far, o), inv))
+            }};
+        }
+        let (nx, fx) = slab!(0);
+        let (ny, fy) = slab!(1);
+        let (nz, fz) = slab!(2);
+        let tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_setzero_ps()));
+        let tf = _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(fx, fy), fz), _mm256_set1_ps(FAR_SCALE));
+        let tf = _mm256_min_ps(tf, _mm256_set1_ps(tmax));
+        _mm256_storeu_ps(t_near.as_mut_ptr(), tn);
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as u32
+    }};
+}
+
+/// The AVX slab test as a function (for tests).
+///
+/// # Safety
+/// The CPU must support AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+pub unsafe fn node_test_avx(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f32; 8]) -> u32 {
+    node_test_avx_body!(node, r, tmax, t_near)
+}
+
+/// `node_test_portable` in the form the traversal macros take.
+macro_rules! node_test_portable_body {
+    ($node:expr, $r:expr, $tmax:expr, $t_near:expr) => {
+        node_test_portable($node, $r, $tmax, $t_near)
+    };
+}
+
+/// Stack entry: a child and a lower bound of its entry distance.
+#[derive(Clone, Copy)]
+pub struct Entry {
+    pub child: u32,
+    pub t: f32,
+}
+
+/// Stack size that suffices for a tree of depth `depth` (at most 7 entries pushed per level).
+pub fn stack_size(depth: usize) -> usize {
+    7 * depth + 1
+}
+
+/// Fixed stack size used when the tree allows it (deeper trees use a heap stack).
+pub const STACK: usize = 128;
+
+/// A traversal stack of `n` entries; only written entries are ever read.
+pub type Stack = [MaybeUninit<Entry>];
+
+/// Closest-hit traversal with node test `$node_test`: `(lane index into lane_prims, t, b1, b2)`
+/// of the nearest triangle in (0, tmax). A macro, so that each instance is compiled with the
+/// target features of the function it expands in and the node test inlines.
+macro_rules! closest_body {
+    ($bvh:expr, $ray:expr, $tmax:expr, $stack:expr, $node_test:ident) => {{
+        let (bvh, ray, mut tmax, stack): (&Bvh8, &Ray, f32, &mut Stack) = ($bvh, $ray, $tmax, $stack);
+        let nr = NodeRay::new(ray.o, ray.d);
+        let wt = WatertightRay::new(ray.o, ray.d);
+        let mut found = None;
+        let mut sp = 0usize;
+        let mut cur = bvh.root;
+        let mut t_near = [0.0f32; 8];
+        'traversal: loop {
+            // Descend through inner nodes to the nearest hit child until a leaf (or nothing) is next.
+            while cur & LEAF == 0 {
+                let node = &bvh.nodes[cur as usize];
+                let mut mask = $node_test!(node, &nr, tmax, &mut t_near);
+                if mask == 0 {
+                    cur = EMPTY;
+                    break;
+                }
+                if mask & (mask - 1) == 0 {
+                    cur = node.child[mask.trailing_zeros() as usize];
+                    continue;
+                }
+                // Two or more: sort by entry distance (non-negative, so its bits sort as integers;
+                // the low three bits carry the slot), push all but the nearest, farthest first.
+                let mut keys = [0u32; 8];
+                let mut n = 0;
+                while mask != 0 {
+                    let slot = mask.trailing_zeros();
+                    mask &= mask - 1;
+                    let key = (t_near[slot as usize].to_bits() & !7) | slot;
+                    let mut i = n;
+                    while i > 0 && keys[i - 1] < key {
+                        keys[i] = keys[i - 1];
+                        i -= 1;
+                    }
+                    keys[i] = key;
+                    n += 1;
+                }
+                for &key in &keys[..n - 1] {
+                    stack[sp] =
+                        MaybeUninit::new(Entry { child: node.child[(key & 7) as usize], t: f32::from_bits(key & !7) });
+                    sp += 1;
+                }
+                cur = node.child[(keys[n - 1] & 7) as usize];
+            }
+            if cur != EMPTY {
+                let packet = (cur & !LEAF) as usize;
+                if let Some((lane, t, b1, b2)) = wt.nearest4(&bvh.packets[packet], tmax) {
+                    tmax = t;
+                    found = Some(((4 * packet + lane) as u32, t, b1, b2));
+                }
+            }
+            // Pop the nearest remaining child that may still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    break 'traversal found;
+                }
+                sp -= 1;
+                // SAFETY: entries below `sp` were written.
+                let e = unsafe { stack[sp].assume_init() };
+                if e.t <= tmax {
+                    cur = e.child;
+                    break;
+                }
+            }
+        }
+    }};
+}
+
+/// Any-hit traversal with node test `$node_test`: true when a triangle is hit in (0, tmax).
+macro_rules! any_body {
+    ($bvh:expr, $ray:expr, $tmax:expr, $stack:expr, $node_test:ident) => {{
+        let (bvh, ray, tmax, stack): (&Bvh8, &Ray, f32, &mut Stack) = ($bvh, $ray, $tmax, $stack);
+        let nr = NodeRay::new(ray.o, ray.d);
+        let wt = WatertightRay::new(ray.o, ray.d);
+        let mut sp = 0usize;
+        let mut cur = bvh.root;
+        let mut t_near = [0.0f32; 8];
+        loop {
+            if cur & LEAF == 0 {
+                let node = &bvh.nodes[cur as usize];
+                let mut mask = $node_test!(node, &nr, tmax, &mut t_near);
+                while mask != 0 {
+                    let slot = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack[sp] = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
+                    sp += 1;
+                }
+            } else if wt.any4(&bvh.packets[(cur & !LEAF) as usize], tmax) {
+                break true;
+            }
+            if sp == 0 {
+                break false;
+            }
+            sp -= 1;
+            // SAFETY: entries below `sp` were written.
+            cur = unsafe { stack[sp].assume_init() }.child;
+        }
+    }};
+}
+
+/// Closest hit, portable node test.
+pub fn closest_portable(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
+    closest_body!(bvh, ray, tmax, stack, node_test_portable_body)
+}
+
+/// Any hit, portable node test.
+pub fn any_portable(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> bool {
+    any_body!(bvh, ray, tmax, stack, node_test_portable_body)
+}
+
+/// Closest hit, AVX node test.
+///
+/// # Safety
+/// The CPU must support AVX2, BMI1, LZCNT and POPCNT (`Isa::detect`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
+pub unsafe fn closest_avx2(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
+    closest_body!(bvh, ray, tmax, stack, node_test_avx_body)
+}
+
+/// Any hit, AVX node test.
+///
+/// # Safety
+/// As for `closest_avx2`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
+pub unsafe fn any_avx2(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> bool {
+    any_body!(bvh, ray, tmax, stack, node_test_avx_body)
+}
