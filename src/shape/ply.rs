@@ -38,7 +38,7 @@ mod body;
 mod header;
 
 use super::mesh_data::MeshData;
-use crate::scene::error::{Error, Result};
+use crate::scene::error::{Error, Result, SrcPos};
 use body::{decode, Ascii, Binary, Plan};
 use header::{parse_header, Format};
 
