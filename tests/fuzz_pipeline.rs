@@ -433,7 +433,7 @@ fn run_folder(dir: &Path) -> Result<(), String> {
             return Err(format!("non-finite value {} in channel {channel} of pixel {}", out.data[i], i / nch));
         }
         // Known defect outside this test's reach: the render squares each finite sample for the
-        // m2.* channels, which overflows for |L| > 1.8e19 (an emitter of radiance 1e38). Counted
+        // m2.* channels, which overflows for |L| > 1.8e19 (an emitter of radiance 2^64). Counted
         // and reported, not failed, until the render rejects such samples.
         M2_OVERFLOWS.fetch_add(1, Ordering::Relaxed);
     }

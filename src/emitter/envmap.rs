@@ -89,6 +89,14 @@ impl EnvironmentEmitter {
         if !(scale.is_finite() && scale >= 0.0) {
             return Err(props.error("scale", "envmap: \"scale\" must be finite and non-negative"));
         }
+        let brightest = pixels.iter().fold(0.0f32, |m, p| m.max(p.abs().max_element()));
+        if !(scale * brightest <= crate::scene::desc::MAX_EMISSION) {
+            let msg = format!(
+                "envmap: scale ({scale:e}) × the brightest pixel ({brightest}) is beyond {:e}",
+                crate::scene::desc::MAX_EMISSION
+            );
+            return Err(props.error("scale", msg));
+        }
         let to_world = props.transform("to_world")?;
         check_transform(props, "to_world", &to_world)?;
         if !is_orthogonal(&to_world) {

@@ -367,6 +367,13 @@ impl Props {
         if !(c.x.is_finite() && c.y.is_finite() && c.z.is_finite()) {
             return Err(Error::at(&p.pos, format!("\"{}\" is not finite", p.name)));
         }
+        // Found by fuzzing: emission near f32::MAX gives finite samples whose pixel sums overflow.
+        if emitter && c.abs().max_element() > MAX_EMISSION {
+            return Err(Error::at(
+                &p.pos,
+                format!("\"{}\" is beyond {MAX_EMISSION:e}, where pixel sums overflow", p.name),
+            ));
+        }
         Ok(Some(c))
     }
     pub fn color(&self, name: &str, default: Spectrum) -> Result<Spectrum> {
@@ -490,6 +497,10 @@ impl Props {
 }
 
 /// Mitsuba's table of named indices of refraction (`ior.h`).
+/// Largest emitted value accepted (radiance, intensity, irradiance, envmap scale × pixel): beyond
+/// it, sums of a few samples × filter weights overflow f32 (found by fuzzing).
+pub const MAX_EMISSION: f32 = 1e30;
+
 pub const IOR_TABLE: &[(&str, f32)] = &[
     ("vacuum", 1.0),
     ("helium", 1.000036),
