@@ -262,9 +262,12 @@ fn chi2_rough_conductor() {
                 let bsdf = rough_conductor(ggx, au, av, visible);
                 for &theta in &THETAS {
                     seed += 1;
-                    // Known deviation, reproduced from Mitsuba (point values agree): Beckmann visible
-                    // normals at α = 0.05 and θi = 85° put ~1 % too few reflections below the horizon
-                    // (3.4 % vs 4.3 % expected); not yet explained, so this one case is left out.
+                    // Known deviation of the shared Beckmann visible-normal sampler (microfacet.rs,
+                    // Mitsuba's algorithm; our samples equal Mitsuba's in point_values_match_mitsuba):
+                    // at α = 0.05 and θi = 85° its normals do not follow the exact visible-normal pdf
+                    // (chi-square over normals alone, 64×128 bins, 200k samples: χ² = 1164 for 128 dof),
+                    // so ~1 % too few reflections fall below the horizon here (3.4 % vs 4.3 %). The
+                    // same sampler passes at θi = 60° and at α = 0.3, θi = 85°. Left out, not hidden.
                     if !ggx && visible && au == 0.05 && theta == 85.0 {
                         continue;
                     }

@@ -506,7 +506,7 @@ fn parameters_and_errors() {
             Err(e) => e.to_string(),
         }
     };
-    let e = err("plastic", vec![]);
+    let e = err("principled", vec![]);
     assert!(e.starts_with("test.xml:1:1:") && e.contains("roughdielectric"), "{}", e);
     assert!(err("roughdielectric", vec![("alhpa", Value::Float(0.1))]).contains("alhpa"));
     assert!(err("roughdielectric", vec![("distribution", Value::String("phong".into()))]).contains("ggx"));

@@ -19,6 +19,11 @@
 //! Mitsuba's `eval_1` does (see [`eval_1`](super::eval_1)). One-sided; one component: 0 = glossy
 //! reflection (flagged anisotropic when `alpha_u`/`alpha_v` are given, as in Mitsuba).
 //!
+//! Anisotropy follows the shading frame's tangent (local x = `alpha_u`). snee builds shading frames
+//! from the normal alone, Mitsuba from dp/du: the two tangents coincide on flat rectangles facing
+//! +Y or +Z (e.g. `rotate x -90` floors), elsewhere an anisotropic highlight is rotated about the
+//! normal relative to Mitsuba's.
+//!
 //! ```xml
 //! <bsdf type="roughconductor">
 //!     <string name="material" value="Al"/>
