@@ -239,7 +239,8 @@ pub fn render_range(
         let ray = scene.camera.sample_ray(pos, aperture);
         let (mut l, valid) = sample_li(scene, sampler, ray, local);
         l *= ray_weight;
-        if !l.is_finite() {
+        // With `moment`, a sample whose square overflows (|l| > ~1.8e19) would write inf into m2.*.
+        if !l.is_finite() || (moment && !(l * l).is_finite()) {
             local.rejected_samples += 1;
             l = Spectrum::ZERO;
         }
