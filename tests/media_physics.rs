@@ -7,34 +7,19 @@
 //!   environment renders the environment;
 //! - no NaN/Inf for degenerate media (σt = 0, albedo 1, g = ±0.99, camera inside a medium).
 
+mod common;
+
 use snee::render::{render, RenderOptions};
-use snee::scene::build::build_scene;
 use snee::scene::world::Scene;
-use snee::scene::xml::parse_str;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 fn load(xml: &str) -> Scene {
-    let parsed =
-        parse_str(xml, "test.xml", Path::new(env!("CARGO_MANIFEST_DIR")), &[]).unwrap_or_else(|e| panic!("{}", e));
-    build_scene(&parsed).unwrap_or_else(|e| panic!("{}", e))
+    common::scene(xml, &[])
 }
 
-/// Mean and standard error of the first channel over `batches` renders of a 1×1 film.
 fn meter_reading(scene: &Scene, spp: u32, batches: u64) -> (f64, f64, u64) {
-    let cancel = AtomicBool::new(false);
-    let mut v = Vec::new();
-    let mut rejected = 0;
-    for b in 0..batches {
-        let out =
-            render(scene, &RenderOptions { spp: Some(spp), seed: 77 + b, time_budget: None, progress: false }, &cancel);
-        rejected += out.stats.rejected_samples;
-        v.push(out.data[0] as f64);
-    }
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt(), rejected)
+    common::meter_reading(scene, spp, batches, 77)
 }
 
 /// A slab 200 mean free paths wide and 100 deep (σt = 1), its top face at z = 0, under a

@@ -14,10 +14,7 @@
 //! medium vertex is an internal reflection, which neither SNEE nor forward tracing can produce
 //! under a delta light behind a smooth interface; they are not tested here.
 
-mod snee_common;
-
-use snee::render::{render, RenderOptions};
-use std::sync::atomic::AtomicBool;
+mod common;
 
 fn slab(integrator: &str, albedo: f64, g: f64) -> String {
     let phase = if g == 0.0 {
@@ -61,20 +58,8 @@ fn single_scattering(albedo: f64, g: f64) -> f64 {
 }
 
 fn reading(integrator: &str, albedo: f64, g: f64, spp: u32, batches: u64) -> (f64, f64, u64) {
-    let scene = snee_common::scene(&slab(integrator, albedo, g), &[]);
-    let cancel = AtomicBool::new(false);
-    let mut v = Vec::new();
-    let mut rejected = 0;
-    for b in 0..batches {
-        let opts = RenderOptions { spp: Some(spp), seed: 101 + b, time_budget: None, progress: false };
-        let out = render(&scene, &opts, &cancel);
-        rejected += out.stats.rejected_samples;
-        v.push(out.data[0] as f64);
-    }
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt(), rejected)
+    let scene = common::scene(&slab(integrator, albedo, g), &[]);
+    common::meter_reading(&scene, spp, batches, 101)
 }
 
 #[test]
@@ -85,10 +70,9 @@ fn isotropic_single_scattering_closed_form() {
 
 #[test]
 fn volpath_reads_zero_snee_matches_adding_doubling() {
-    let data: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(snee_common::root().join("tests/data/adding_doubling.json")).unwrap(),
-    )
-    .unwrap();
+    let data: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::root().join("tests/data/adding_doubling.json")).unwrap())
+            .unwrap();
     let entries = data["entries"].as_array().unwrap();
     let (r_vp, _, _) = reading("volpath", 0.8, 0.0, 4096, 2);
     assert_eq!(r_vp, 0.0, "volpath cannot connect a delta light through a smooth interface");
