@@ -22,35 +22,9 @@ fn meter_reading(scene: &Scene, spp: u32, batches: u64) -> (f64, f64, u64) {
     common::meter_reading(scene, spp, batches, 77)
 }
 
-/// A slab 200 mean free paths wide and 100 deep (σt = 1), its top face at z = 0, under a
-/// directional beam travelling along −z, with a 10×10 meter quad facing down just above it.
+/// The slab of `common::slab_xml` with an index-matched (`null`) boundary, under `volpath`.
 fn slab_scene(albedo: f64, g: f64) -> String {
-    let phase = if g == 0.0 {
-        r#"<phase type="isotropic"/>"#.to_string()
-    } else {
-        format!(r#"<phase type="hg"><float name="g" value="{g}"/></phase>"#)
-    };
-    format!(
-        r#"<scene version="3.0.0">
-    <integrator type="volpath"><integer name="max_depth" value="-1"/></integrator>
-    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
-    <medium type="homogeneous" id="slab">
-        <float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>{phase}
-    </medium>
-    <shape type="cube">
-        <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
-        <bsdf type="null"/>
-        <ref name="interior" id="slab"/>
-    </shape>
-    <shape type="rectangle">
-        <transform name="to_world"><scale value="5"/><rotate x="1" angle="180"/><translate z="0.01"/></transform>
-        <bsdf type="null"/>
-        <sensor type="irradiancemeter">
-            <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
-        </sensor>
-    </shape>
-</scene>"#
-    )
+    common::slab_xml("volpath", albedo, g, r#"<bsdf type="null"/>"#)
 }
 
 #[test]

@@ -16,31 +16,11 @@
 
 mod common;
 
+/// The slab of `common::slab_xml` behind a smooth n = 1 dielectric (a delta interface).
 fn slab(integrator: &str, albedo: f64, g: f64) -> String {
-    let phase = if g == 0.0 {
-        r#"<phase type="isotropic"/>"#.to_string()
-    } else {
-        format!(r#"<phase type="hg"><float name="g" value="{g}"/></phase>"#)
-    };
-    format!(
-        r#"<scene version="3.0.0">
-    <integrator type="{integrator}"><integer name="max_depth" value="-1"/></integrator>
-    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
-    <medium type="homogeneous" id="slab"><float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>{phase}</medium>
-    <shape type="cube">
-        <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
-        <bsdf type="dielectric"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf>
-        <ref name="interior" id="slab"/>
-    </shape>
-    <shape type="rectangle">
-        <transform name="to_world"><scale value="5"/><rotate x="1" angle="180"/><translate z="0.01"/></transform>
-        <bsdf type="null"/>
-        <sensor type="irradiancemeter">
-            <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
-        </sensor>
-    </shape>
-</scene>"#
-    )
+    let boundary =
+        r#"<bsdf type="dielectric"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf>"#;
+    common::slab_xml(integrator, albedo, g, boundary)
 }
 
 /// Single-scattering reflectance of a semi-infinite index-matched slab at normal incidence.

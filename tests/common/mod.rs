@@ -131,3 +131,33 @@ pub fn meter_reading(scene: &Scene, spp: u32, batches: u64, seed0: u64) -> (f64,
     let (m, var) = mean_var(&v);
     (m, (var / v.len() as f64).sqrt(), rejected)
 }
+
+/// A slab 200 mean free paths wide and 100 deep (σt = 1, albedo `albedo`, HG `g`), its top face at
+/// z = 0, bounded by the BSDF `boundary` (XML), under a directional beam travelling along −z, read
+/// by an `irradiancemeter` on a 10×10 `null` quad facing down just above it.
+pub fn slab_xml(integrator: &str, albedo: f64, g: f64, boundary: &str) -> String {
+    let phase = if g == 0.0 {
+        r#"<phase type="isotropic"/>"#.to_string()
+    } else {
+        format!(r#"<phase type="hg"><float name="g" value="{g}"/></phase>"#)
+    };
+    format!(
+        r#"<scene version="3.0.0">
+    <integrator type="{integrator}"><integer name="max_depth" value="-1"/></integrator>
+    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
+    <medium type="homogeneous" id="slab"><float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>{phase}</medium>
+    <shape type="cube">
+        <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
+        {boundary}
+        <ref name="interior" id="slab"/>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="5"/><rotate x="1" angle="180"/><translate z="0.01"/></transform>
+        <bsdf type="null"/>
+        <sensor type="irradiancemeter">
+            <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
+        </sensor>
+    </shape>
+</scene>"#
+    )
+}
