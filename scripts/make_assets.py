@@ -43,6 +43,8 @@ import zlib
 
 import numpy as np
 
+import common
+
 SUN_ELEVATION_DEG = 40.0
 SUN_AZIMUTH_DEG = -60.0  # azimuth phi = 2*pi*u measured from +Z towards +X
 SUN_RADIUS_DEG = 3.5
@@ -51,52 +53,16 @@ SUN_RADIANCE = np.array([150.0, 140.0, 120.0])
 
 # ----------------------------------------------------------------------------- textures
 
-def envmap_direction(theta, phi):
-    """Direction for polar angle theta (from +Y) and azimuth phi = 2*pi*u (Mitsuba envmap)."""
-    st = np.sin(theta)
-    return np.stack([st * np.sin(phi), np.cos(theta), -st * np.cos(phi)], axis=-1)
-
-
 def sun_direction():
-    theta = math.radians(90.0 - SUN_ELEVATION_DEG)
-    phi = math.radians(SUN_AZIMUTH_DEG)
-    return envmap_direction(np.float64(theta), np.float64(phi))
+    return common.sun_direction(SUN_ELEVATION_DEG, SUN_AZIMUTH_DEG)
 
 
 def make_sky(width=256, height=128, supersample=4):
-    """Lat-long sky, shape (height, width, 3), float32, Mitsuba's lat-long layout."""
-    sun = sun_direction()
-    cos_sun_radius = math.cos(math.radians(SUN_RADIUS_DEG))
-    img = np.zeros((height, width, 3))
-    # Supersample each texel (over its bilinear footprint) so the sun disc has soft, stable edges.
-    offs = (np.arange(supersample) + 0.5) / supersample - 0.5
-    for oy in offs:
-        for ox in offs:
-            j = np.clip(np.arange(height)[:, None] + oy, 0, height - 1)
-            i = np.arange(width)[None, :] + ox
-            theta = j / (height - 1) * np.pi
-            phi = (i + 0.5) / width * 2 * np.pi
-            theta, phi = np.broadcast_arrays(theta, phi)
-            d = envmap_direction(theta, phi)
-            y = d[..., 1]
-            cos_to_sun = d @ sun
-            # Sky above the horizon: zenith blue to pale horizon, a glow around the sun.
-            h = np.clip(y, 0.0, 1.0)[..., None]
-            zenith = np.array([0.18, 0.35, 0.85])
-            horizon = np.array([0.85, 0.9, 1.0])
-            sky = horizon + (zenith - horizon) * np.sqrt(h)
-            glow = 0.6 * np.exp(8.0 * (cos_to_sun - 1.0))[..., None] * np.array([1.0, 0.85, 0.6])
-            sky = sky + glow
-            # Ground below the horizon: dim warm brown, darker straight down.
-            g = np.clip(-y, 0.0, 1.0)[..., None]
-            ground = np.array([0.3, 0.25, 0.2]) * (1.0 - 0.5 * g)
-            col = np.where((y >= 0.0)[..., None], sky, ground)
-            col = np.where((cos_to_sun >= cos_sun_radius)[..., None], SUN_RADIANCE, col)
-            img += col
-    img /= supersample * supersample
-    # Round to values a half float can hold (stored as float32): the zeroed low mantissa bits
-    # let the lossless PIZ compressor keep the file small.
-    return img.astype(np.float16).astype(np.float32)
+    """Lat-long sky, shape (height, width, 3), float32, Mitsuba's lat-long layout: zenith blue to a
+    pale horizon, a glow around the sun, the sun disc, a dim warm brown ground."""
+    return common.lat_long_sky(sun_direction(), SUN_RADIUS_DEG, SUN_RADIANCE, zenith=[0.18, 0.35, 0.85],
+                               horizon=[0.85, 0.9, 1.0], glow=0.6, glow_sharpness=8.0, glow_color=[1.0, 0.85, 0.6],
+                               ground=[0.3, 0.25, 0.2], width=width, height=height, supersample=supersample)
 
 
 def srgb_encode(x):
@@ -152,17 +118,6 @@ def icosphere(subdivisions):
     return np.array(verts), np.array(faces, dtype=np.int64)
 
 
-def vertex_normals(verts, faces):
-    """Area-weighted vertex normals."""
-    e1 = verts[faces[:, 1]] - verts[faces[:, 0]]
-    e2 = verts[faces[:, 2]] - verts[faces[:, 0]]
-    fn = np.cross(e1, e2)
-    n = np.zeros_like(verts)
-    for k in range(3):
-        np.add.at(n, faces[:, k], fn)
-    return n / np.linalg.norm(n, axis=1, keepdims=True)
-
-
 def check_outward(verts, faces):
     """Signed volume must be positive for outward counter-clockwise winding."""
     a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
@@ -213,23 +168,7 @@ def torus_mesh(major=0.7, minor=0.25, nu=24, nv=12):
 
 
 def write_ply_binary(path, verts, faces, normals):
-    header = (
-        "ply\nformat binary_little_endian 1.0\n"
-        "comment snee test asset written by scripts/make_assets.py\n"
-        f"element vertex {len(verts)}\n"
-        "property float x\nproperty float y\nproperty float z\n"
-        "property float nx\nproperty float ny\nproperty float nz\n"
-        f"element face {len(faces)}\n"
-        "property list uchar int vertex_indices\nend_header\n"
-    )
-    vdata = np.hstack([verts, normals]).astype("<f4")
-    fdata = np.zeros(len(faces), dtype=[("n", "u1"), ("i", "<i4", 3)])
-    fdata["n"] = 3
-    fdata["i"] = faces
-    with open(path, "wb") as fh:
-        fh.write(header.encode("ascii"))
-        fh.write(vdata.tobytes())
-        fh.write(fdata.tobytes())
+    common.write_ply_binary(path, verts, faces, normals, "snee test asset written by scripts/make_assets.py")
 
 
 def write_ply_ascii(path, verts, faces, uvs):
@@ -365,7 +304,7 @@ def main():
     bv, bf = blob_mesh()
     check_outward(bv, bf)
     blob_path = os.path.join(out, "meshes", "blob.ply")
-    write_ply_binary(blob_path, bv, bf, vertex_normals(bv, bf))
+    write_ply_binary(blob_path, bv, bf, common.vertex_normals(bv, bf))
     print(f"wrote {blob_path}  ({len(bv)} vertices, {len(bf)} triangles, binary, normals)")
 
     pv, pf, puv = pebble_mesh()
@@ -385,7 +324,7 @@ def main():
     check_outward(tv, tf)
     ser_path = os.path.join(out, "meshes", "two_meshes.serialized")
     write_serialized(ser_path, [
-        dict(name="rock", verts=rv, faces=rf, normals=vertex_normals(rv, rf)),
+        dict(name="rock", verts=rv, faces=rf, normals=common.vertex_normals(rv, rf)),
         dict(name="torus", verts=tv, faces=tf, uvs=tuv),
     ])
     print(f"wrote {ser_path}  (0: rock {len(rv)} v / {len(rf)} f with normals; "

@@ -29,6 +29,8 @@ import sys
 
 import numpy as np
 
+import common
+
 RINGS = 322  # rings of the surface of revolution (including the two pole rings)
 SEGMENTS = 194  # vertices around each ring
 SUN_ELEVATION_DEG = 55.0
@@ -123,15 +125,6 @@ def signed_volume(verts, faces):
     return np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0
 
 
-def vertex_normals(verts, faces):
-    """Area-weighted vertex normals."""
-    fn = np.cross(verts[faces[:, 1]] - verts[faces[:, 0]], verts[faces[:, 2]] - verts[faces[:, 0]])
-    n = np.zeros_like(verts)
-    for k in range(3):
-        np.add.at(n, faces[:, k], fn)
-    return n / np.linalg.norm(n, axis=1, keepdims=True)
-
-
 def check_closed(faces):
     """Every undirected edge is shared by exactly two faces, with opposite orientations."""
     e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
@@ -142,66 +135,20 @@ def check_closed(faces):
 
 
 def write_ply_binary(path, verts, faces, normals):
-    header = (
-        "ply\nformat binary_little_endian 1.0\n"
-        "comment procedural statue written by scripts/make_figure_assets.py\n"
-        f"element vertex {len(verts)}\n"
-        "property float x\nproperty float y\nproperty float z\n"
-        "property float nx\nproperty float ny\nproperty float nz\n"
-        f"element face {len(faces)}\n"
-        "property list uchar int vertex_indices\nend_header\n"
-    )
-    vdata = np.hstack([verts, normals]).astype("<f4")
-    fdata = np.zeros(len(faces), dtype=[("n", "u1"), ("i", "<i4", 3)])
-    fdata["n"] = 3
-    fdata["i"] = faces
-    with open(path, "wb") as fh:
-        fh.write(header.encode("ascii"))
-        fh.write(vdata.tobytes())
-        fh.write(fdata.tobytes())
+    common.write_ply_binary(path, verts, faces, normals, "procedural statue written by scripts/make_figure_assets.py")
 
 
 # ----------------------------------------------------------------------------- environment map
 
-def envmap_direction(theta, phi):
-    """Direction for polar angle theta (from +Y) and azimuth phi = 2*pi*u (Mitsuba envmap)."""
-    st = np.sin(theta)
-    return np.stack([st * np.sin(phi), np.cos(theta), -st * np.cos(phi)], axis=-1)
-
-
 def sun_direction():
-    return envmap_direction(np.float64(math.radians(90.0 - SUN_ELEVATION_DEG)),
-                            np.float64(math.radians(SUN_AZIMUTH_DEG)))
+    return common.sun_direction(SUN_ELEVATION_DEG, SUN_AZIMUTH_DEG)
 
 
 def make_sun_sky(width=256, height=128, supersample=4):
     """Lat-long sun and sky, shape (height, width, 3), float32."""
-    sun = sun_direction()
-    cos_sun_radius = math.cos(math.radians(SUN_RADIUS_DEG))
-    img = np.zeros((height, width, 3))
-    offs = (np.arange(supersample) + 0.5) / supersample - 0.5
-    for oy in offs:
-        for ox in offs:
-            j = np.clip(np.arange(height)[:, None] + oy, 0, height - 1)
-            i = np.arange(width)[None, :] + ox
-            theta = j / (height - 1) * np.pi
-            phi = (i + 0.5) / width * 2 * np.pi
-            theta, phi = np.broadcast_arrays(theta, phi)
-            d = envmap_direction(theta, phi)
-            yy = d[..., 1]
-            cos_to_sun = d @ sun
-            h = np.clip(yy, 0.0, 1.0)[..., None]
-            zenith = np.array([0.10, 0.22, 0.60])
-            horizon = np.array([0.60, 0.68, 0.80])
-            sky = horizon + (zenith - horizon) * np.sqrt(h)
-            sky = sky + 0.8 * np.exp(12.0 * (cos_to_sun - 1.0))[..., None] * np.array([1.0, 0.8, 0.55])
-            g = np.clip(-yy, 0.0, 1.0)[..., None]
-            ground = np.array([0.12, 0.10, 0.08]) * (1.0 - 0.5 * g)
-            col = np.where((yy >= 0.0)[..., None], sky, ground)
-            col = np.where((cos_to_sun >= cos_sun_radius)[..., None], SUN_RADIANCE, col)
-            img += col
-    img /= supersample * supersample
-    return img.astype(np.float16).astype(np.float32)
+    return common.lat_long_sky(sun_direction(), SUN_RADIUS_DEG, SUN_RADIANCE, zenith=[0.10, 0.22, 0.60],
+                               horizon=[0.60, 0.68, 0.80], glow=0.8, glow_sharpness=12.0, glow_color=[1.0, 0.8, 0.55],
+                               ground=[0.12, 0.10, 0.08], width=width, height=height, supersample=supersample)
 
 
 # ----------------------------------------------------------------------------- scenes
@@ -347,7 +294,7 @@ def main():
 
     verts, faces = statue_mesh()
     check_closed(faces)
-    normals = vertex_normals(verts, faces)
+    normals = common.vertex_normals(verts, faces)
     ply = os.path.join(out, "statue.ply")
     write_ply_binary(ply, verts, faces, normals)
     lo, hi = verts.min(axis=0), verts.max(axis=0)

@@ -7,65 +7,24 @@
 //!   environment renders the environment;
 //! - no NaN/Inf for degenerate media (σt = 0, albedo 1, g = ±0.99, camera inside a medium).
 
+mod common;
+
 use snee::render::{render, RenderOptions};
-use snee::scene::build::build_scene;
 use snee::scene::world::Scene;
-use snee::scene::xml::parse_str;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 fn load(xml: &str) -> Scene {
-    let parsed =
-        parse_str(xml, "test.xml", Path::new(env!("CARGO_MANIFEST_DIR")), &[]).unwrap_or_else(|e| panic!("{}", e));
-    build_scene(&parsed).unwrap_or_else(|e| panic!("{}", e))
+    common::scene(xml, &[])
 }
 
-/// Mean and standard error of the first channel over `batches` renders of a 1×1 film.
 fn meter_reading(scene: &Scene, spp: u32, batches: u64) -> (f64, f64, u64) {
-    let cancel = AtomicBool::new(false);
-    let mut v = Vec::new();
-    let mut rejected = 0;
-    for b in 0..batches {
-        let out =
-            render(scene, &RenderOptions { spp: Some(spp), seed: 77 + b, time_budget: None, progress: false }, &cancel);
-        rejected += out.stats.rejected_samples;
-        v.push(out.data[0] as f64);
-    }
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt(), rejected)
+    common::meter_reading(scene, spp, batches, 77)
 }
 
-/// A slab 200 mean free paths wide and 100 deep (σt = 1), its top face at z = 0, under a
-/// directional beam travelling along −z, with a 10×10 meter quad facing down just above it.
+/// The slab of `common::slab_xml` with an index-matched (`null`) boundary, under `volpath`.
 fn slab_scene(albedo: f64, g: f64) -> String {
-    let phase = if g == 0.0 {
-        r#"<phase type="isotropic"/>"#.to_string()
-    } else {
-        format!(r#"<phase type="hg"><float name="g" value="{g}"/></phase>"#)
-    };
-    format!(
-        r#"<scene version="3.0.0">
-    <integrator type="volpath"><integer name="max_depth" value="-1"/></integrator>
-    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
-    <medium type="homogeneous" id="slab">
-        <float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>{phase}
-    </medium>
-    <shape type="cube">
-        <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
-        <bsdf type="null"/>
-        <ref name="interior" id="slab"/>
-    </shape>
-    <shape type="rectangle">
-        <transform name="to_world"><scale value="5"/><rotate x="1" angle="180"/><translate z="0.01"/></transform>
-        <bsdf type="null"/>
-        <sensor type="irradiancemeter">
-            <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
-        </sensor>
-    </shape>
-</scene>"#
-    )
+    common::slab_xml("volpath", albedo, g, r#"<bsdf type="null"/>"#)
 }
 
 #[test]

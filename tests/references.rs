@@ -24,6 +24,7 @@ use snee::compare::erfc;
 use snee::io::read::read_image;
 use snee::render::{render, RenderOptions};
 use snee::scene::build::load_scene;
+use snee::testing::chi2::sidak;
 use snee::testing::student_t::t_p_value;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -42,10 +43,6 @@ struct Image {
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn sidak(alpha: f64, n: usize) -> f64 {
-    1.0 - (1.0 - alpha).powf(1.0 / n.max(1) as f64)
 }
 
 /// Per-pixel variance factor of the reconstruction filter: f(x, y) = f1(x) f1(y) with
@@ -329,7 +326,7 @@ fn spot_point() {
 // 0 failures in 15 trials; media_inside failed the per-pixel test in 2 of 15, so blocks only).
 // Light that reaches a medium only through glass makes pixel values heavy-tailed (reference/README.md).
 
-// Ignored: fails at 16 x 16 spp on a heavy-tailed block (block 65, G: ours 0.1892 vs ref 0.2194,
+// At 16 x 16 spp this fails on a heavy-tailed block (block 65, G: ours 0.1892 vs ref 0.2194,
 // -13.8 %, p = 3.01e-5 < 3.07e-5). The sun is reached from the medium only by refracting out of the
 // smooth glass, so a few rare samples carry most of the light. Not a visible bias: at 2048 spp our
 // image mean is -0.14/-0.12/-0.09 % (R/G/B) from the reference and 8x8 block z-scores have std 0.81,
@@ -355,7 +352,7 @@ fn media_inside() {
 fn media_thin() {
     check_scene("media_thin", 16, false);
 }
-// Ignored: fails at 16 x 16 spp (block 31, B: ours 0.0321 vs ref 0.0363, -11.7 %, p = 1.1e-5 <
+// At 16 x 16 spp this fails (block 31, B: ours 0.0321 vs ref 0.0363, -11.7 %, p = 1.1e-5 <
 // 3.07e-5) and worse at 16 x 32 spp (block 58, R: -19.9 %, p = 2.1e-7). Light enters the medium
 // only by emitter sampling at the Beckmann (alpha 0.1) boundary, a narrow lobe: the pixel values
 // are firefly-dominated (two Mitsuba renders at 256 spp: per-pixel max |z| = 62, 219 pixel-channels

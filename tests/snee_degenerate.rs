@@ -2,7 +2,7 @@
 //! σt with a zero channel), behind smooth and rough boundaries, under directional, constant and
 //! area light; and the distance-sampling mixture against its density (1-D histogram, chi-square).
 
-mod snee_common;
+mod common;
 
 use snee::integrator::snee::distance::DistanceSampler;
 use snee::math::Vec3;
@@ -43,7 +43,7 @@ fn no_nan_or_inf() {
     let cancel = AtomicBool::new(false);
     for m in media {
         for b in bsdfs {
-            let scene = snee_common::scene(&xml(m, b), &[]);
+            let scene = common::scene(&xml(m, b), &[]);
             let out =
                 render(&scene, &RenderOptions { spp: Some(16), seed: 9, time_budget: None, progress: false }, &cancel);
             assert_eq!(out.stats.rejected_samples, 0, "{} / {}", m, b);

@@ -14,36 +14,13 @@
 //! medium vertex is an internal reflection, which neither SNEE nor forward tracing can produce
 //! under a delta light behind a smooth interface; they are not tested here.
 
-mod snee_common;
+mod common;
 
-use snee::render::{render, RenderOptions};
-use std::sync::atomic::AtomicBool;
-
+/// The slab of `common::slab_xml` behind a smooth n = 1 dielectric (a delta interface).
 fn slab(integrator: &str, albedo: f64, g: f64) -> String {
-    let phase = if g == 0.0 {
-        r#"<phase type="isotropic"/>"#.to_string()
-    } else {
-        format!(r#"<phase type="hg"><float name="g" value="{g}"/></phase>"#)
-    };
-    format!(
-        r#"<scene version="3.0.0">
-    <integrator type="{integrator}"><integer name="max_depth" value="-1"/></integrator>
-    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
-    <medium type="homogeneous" id="slab"><float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>{phase}</medium>
-    <shape type="cube">
-        <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
-        <bsdf type="dielectric"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf>
-        <ref name="interior" id="slab"/>
-    </shape>
-    <shape type="rectangle">
-        <transform name="to_world"><scale value="5"/><rotate x="1" angle="180"/><translate z="0.01"/></transform>
-        <bsdf type="null"/>
-        <sensor type="irradiancemeter">
-            <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
-        </sensor>
-    </shape>
-</scene>"#
-    )
+    let boundary =
+        r#"<bsdf type="dielectric"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf>"#;
+    common::slab_xml(integrator, albedo, g, boundary)
 }
 
 /// Single-scattering reflectance of a semi-infinite index-matched slab at normal incidence.
@@ -61,20 +38,8 @@ fn single_scattering(albedo: f64, g: f64) -> f64 {
 }
 
 fn reading(integrator: &str, albedo: f64, g: f64, spp: u32, batches: u64) -> (f64, f64, u64) {
-    let scene = snee_common::scene(&slab(integrator, albedo, g), &[]);
-    let cancel = AtomicBool::new(false);
-    let mut v = Vec::new();
-    let mut rejected = 0;
-    for b in 0..batches {
-        let opts = RenderOptions { spp: Some(spp), seed: 101 + b, time_budget: None, progress: false };
-        let out = render(&scene, &opts, &cancel);
-        rejected += out.stats.rejected_samples;
-        v.push(out.data[0] as f64);
-    }
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt(), rejected)
+    let scene = common::scene(&slab(integrator, albedo, g), &[]);
+    common::meter_reading(&scene, spp, batches, 101)
 }
 
 #[test]
@@ -85,10 +50,9 @@ fn isotropic_single_scattering_closed_form() {
 
 #[test]
 fn volpath_reads_zero_snee_matches_adding_doubling() {
-    let data: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(snee_common::root().join("tests/data/adding_doubling.json")).unwrap(),
-    )
-    .unwrap();
+    let data: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(common::root().join("tests/data/adding_doubling.json")).unwrap())
+            .unwrap();
     let entries = data["entries"].as_array().unwrap();
     let (r_vp, _, _) = reading("volpath", 0.8, 0.0, 4096, 2);
     assert_eq!(r_vp, 0.0, "volpath cannot connect a delta light through a smooth interface");

@@ -4,9 +4,9 @@
 //!   independent batches, Šidák-corrected at 1 %);
 //! - with `transport = snee`, the `snee`, `forward` and `mis` modes agree with each other.
 
-mod snee_common;
+mod common;
 
-use snee_common::{render_batches, scene, welch_compare};
+use common::{render_batches, scene, welch_compare};
 
 fn xml(integrator: &str, extra: &str) -> String {
     format!(
@@ -88,7 +88,7 @@ fn partial_rate_agrees_with_full_rate() {
 #[test]
 fn rate_out_of_range_is_an_error() {
     let text = xml("volpath_snee", r#"<float name="snee_rate" value="1.5"/>"#);
-    let parsed = snee::scene::xml::parse_str(&text, "rate.xml", &snee_common::root().join("scenes"), &[]).unwrap();
+    let parsed = snee::scene::xml::parse_str(&text, "rate.xml", &common::root().join("scenes"), &[]).unwrap();
     let err = snee::scene::build::build_scene(&parsed).err().expect("snee_rate 1.5 must be rejected");
     let s = err.to_string();
     assert!(s.starts_with("rate.xml:2:") && s.contains("snee_rate must be in [0, 1]"), "{}", s);

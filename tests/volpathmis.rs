@@ -16,6 +16,9 @@
 //! Pixels are rendered here directly with `li` (box filter: each sample counts for its own
 //! pixel), so every sample is independent.
 
+mod common;
+
+use common::{mean_var, sidak, t_p_value};
 use rayon::prelude::*;
 use snee::color::Spectrum;
 use snee::integrator::stats::LocalStats;
@@ -23,11 +26,7 @@ use snee::integrator::volpathmis::RouletteMis;
 use snee::integrator::{volpath, volpathmis};
 use snee::math::Vec2;
 use snee::sampler::Sampler;
-use snee::scene::build::build_scene;
 use snee::scene::world::Scene;
-use snee::scene::xml::parse_str;
-use snee::testing::chi2::ln_gamma;
-use std::path::PathBuf;
 
 const ALPHA: f64 = 0.01;
 const BATCHES: usize = 16;
@@ -106,15 +105,6 @@ fn scene_xml(boundary: Boundary, sigma_t: [f32; 3], scale: f32, lights: Lights, 
 </scene>"#,
         sigma_t[0], sigma_t[1], sigma_t[2]
     )
-}
-
-fn scenes_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes")
-}
-
-fn load(xml: &str) -> Scene {
-    let parsed = parse_str(xml, "volpathmis_test.xml", &scenes_dir(), &[]).unwrap_or_else(|e| panic!("{}", e));
-    build_scene(&parsed).unwrap_or_else(|e| panic!("{}", e))
 }
 
 /// Per-batch images (mean per pixel), the per-pixel per-sample variance, and the number of
@@ -196,56 +186,6 @@ fn region_batch_means(r: &Renders, px: &[usize], c: usize) -> Vec<f64> {
     r.batches.iter().map(|b| px.iter().map(|&i| b[i][c]).sum::<f64>() / px.len() as f64).collect()
 }
 
-fn mean_var(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    (m, v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0))
-}
-
-/// Regularized incomplete beta I_x(a, b) (continued fraction, modified Lentz).
-fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
-    if x <= 0.0 {
-        return 0.0;
-    }
-    if x >= 1.0 {
-        return 1.0;
-    }
-    if x > (a + 1.0) / (a + b + 2.0) {
-        return 1.0 - incomplete_beta(b, a, 1.0 - x);
-    }
-    let front = (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp() / a;
-    let tiny = 1e-300;
-    let (mut c, mut d) = (1.0, 1.0 - (a + b) * x / (a + 1.0));
-    d = 1.0 / if d.abs() < tiny { tiny } else { d };
-    let mut f = d;
-    for m in 1..500 {
-        let m = m as f64;
-        for num in [
-            m * (b - m) * x / ((a + 2.0 * m - 1.0) * (a + 2.0 * m)),
-            -(a + m) * (a + b + m) * x / ((a + 2.0 * m) * (a + 2.0 * m + 1.0)),
-        ] {
-            d = 1.0 + num * d;
-            d = 1.0 / if d.abs() < tiny { tiny } else { d };
-            c = 1.0 + num / c;
-            c = if c.abs() < tiny { tiny } else { c };
-            f *= c * d;
-        }
-        if (c * d - 1.0).abs() < 1e-14 {
-            break;
-        }
-    }
-    front * f
-}
-
-/// Two-sided p-value of Student's t with `dof` degrees of freedom.
-fn t_p_value(t: f64, dof: f64) -> f64 {
-    incomplete_beta(0.5 * dof, 0.5, dof / (dof + t * t))
-}
-
-fn sidak(alpha: f64, n: usize) -> f64 {
-    1.0 - (1.0 - alpha).powf(1.0 / n as f64)
-}
-
 /// Welch's t-test of two means with squared standard errors `se2` from `n` samples each:
 /// (two-sided p-value, difference, its standard error).
 fn welch(a: (f64, f64, usize), b: (f64, f64, usize)) -> (f64, f64, f64) {
@@ -313,27 +253,16 @@ fn mean_sample_var(r: &Renders) -> [f64; 3] {
     [0, 1, 2].map(|c| r.sample_var.iter().map(|v| v[c]).sum::<f64>() / n)
 }
 
-/// volpath and volpathmis agree in expectation; returns the variance ratio volpath / volpathmis.
-fn agree_and_variance(name: &str, xml: &str, spp_per_batch: u32) -> [f64; 3] {
-    let scene = load(xml);
+/// volpath and volpathmis agree in expectation (Welch tests on the image and its blocks).
+fn agree(name: &str, xml: &str, spp_per_batch: u32) {
+    let scene = common::scene(xml, &[]);
     let a = render(&scene, Integrator::Volpathmis, spp_per_batch, 7);
     let b = render(&scene, Integrator::Volpath, spp_per_batch, 8);
     assert_eq!(a.non_finite + b.non_finite, 0, "{}: non-finite samples", name);
-    let result = compare_means(&a, &b);
-    let (va, vb) = (mean_sample_var(&a), mean_sample_var(&b));
-    let ratio = [0, 1, 2].map(|c| vb[c] / va[c]);
-    eprintln!(
-        "{}: volpathmis vs volpath: {}\n  per-sample variance volpath / volpathmis = {:.3} {:.3} {:.3}",
-        name,
-        result.as_ref().unwrap_or_else(|e| e),
-        ratio[0],
-        ratio[1],
-        ratio[2]
-    );
-    if let Err(e) = result {
-        panic!("{}: volpathmis and volpath disagree: {}", name, e);
+    match compare_means(&a, &b) {
+        Ok(text) => eprintln!("{}: volpathmis vs volpath: {}", name, text),
+        Err(e) => panic!("{}: volpathmis and volpath disagree: {}", name, e),
     }
-    ratio
 }
 
 /// Mildly chromatic: σt,max / σt,min = 1.6 < 2, so `volpath`'s weights Tr/pdf[hero] have finite
@@ -348,14 +277,14 @@ const NO_ROULETTE: &str = r#"<integer name="max_depth" value="64"/><integer name
 #[test]
 fn agrees_with_volpath_null_boundary() {
     let xml = scene_xml(Boundary::Null, MILD, 4.0, Lights::ConstantDirectional, 32, NO_ROULETTE);
-    agree_and_variance("null boundary, constant + directional", &xml, 8);
+    agree("null boundary, constant + directional", &xml, 8);
 }
 
 #[test]
 fn agrees_with_volpath_thindielectric_boundary() {
     // Shadow rays through a thin dielectric carry its null transmission (< 1).
     let xml = scene_xml(Boundary::ThinDielectric, MILD, 4.0, Lights::Envmap, 32, NO_ROULETTE);
-    agree_and_variance("thindielectric boundary, envmap", &xml, 8);
+    agree("thindielectric boundary, envmap", &xml, 8);
 }
 
 #[test]
@@ -365,7 +294,7 @@ fn agrees_with_volpath_dielectric_boundary() {
         ("dielectric boundary, constant + directional", Lights::ConstantDirectional),
     ] {
         let xml = scene_xml(Boundary::Dielectric, MILD, 4.0, lights, 32, NO_ROULETTE);
-        agree_and_variance(name, &xml, 8);
+        agree(name, &xml, 8);
     }
 }
 
@@ -381,7 +310,7 @@ fn lower_variance_on_chromatic_media() {
         ("null boundary, constant + directional", Boundary::Null, Lights::ConstantDirectional),
         ("dielectric boundary, envmap", Boundary::Dielectric, Lights::Envmap),
     ] {
-        let scene = load(&scene_xml(boundary, CHROMATIC, 4.0, lights, 32, ""));
+        let scene = common::scene(&scene_xml(boundary, CHROMATIC, 4.0, lights, 32, ""), &[]);
         let a = render(&scene, Integrator::Volpathmis, 4, 11);
         let b = render(&scene, Integrator::Volpath, 4, 12);
         assert_eq!(a.non_finite + b.non_finite, 0, "{}: non-finite samples", name);
@@ -450,7 +379,7 @@ fn matches_mitsuba_volpathmis() {
     let level = sidak(ALPHA, MITSUBA.len() * 3);
     let mut failures = Vec::new();
     for r in &MITSUBA {
-        let scene = load(&scene_xml(r.boundary, r.sigma_t, 4.0, r.lights, 32, ""));
+        let scene = common::scene(&scene_xml(r.boundary, r.sigma_t, 4.0, r.lights, 32, ""), &[]);
         let ours = render(&scene, Integrator::Volpathmis, r.our_spp_per_batch, 21);
         assert_eq!(ours.non_finite, 0, "{}: non-finite samples", r.name);
         let px: Vec<usize> = (0..ours.w * ours.h).collect();
@@ -491,7 +420,7 @@ fn zero_sigma_channel_in_unbounded_medium() {
     <emitter type="constant"><rgb name="radiance" value="{l}"/></emitter>
 </scene>"#
     );
-    let scene = load(&xml);
+    let scene = common::scene(&xml, &[]);
     assert!(scene.sensor_medium.is_some());
     let r = render(&scene, Integrator::Volpathmis, 16, 5);
     assert_eq!(r.non_finite, 0, "non-finite samples");
@@ -517,14 +446,10 @@ const MITSUBA_RR_VOLPATH: ([f64; 3], [f64; 3]) = ([0.254781, 0.229848, 0.270871]
 /// the bias, and our `li` (`RouletteMis::Unbiased`) agrees with volpath.
 #[test]
 fn roulette_bias_is_mitsubas() {
-    let scene = load(&scene_xml(
-        Boundary::Null,
-        [0.5; 3],
-        4.0,
-        Lights::Constant,
-        32,
-        r#"<integer name="rr_depth" value="1"/>"#,
-    ));
+    let scene = common::scene(
+        &scene_xml(Boundary::Null, [0.5; 3], 4.0, Lights::Constant, 32, r#"<integer name="rr_depth" value="1"/>"#),
+        &[],
+    );
     let level = sidak(ALPHA, 6);
     let px: Vec<usize> = (0..32 * 32).collect();
     let image_mean = |r: &Renders| [0, 1, 2].map(|c| summary(&region_batch_means(r, &px, c)));

@@ -123,6 +123,15 @@ pub struct EmitterHit {
     pub light_p: Vec3,
 }
 
+/// What an estimator's call needs besides its own arguments: the scene, the hero channel, the
+/// path's sample stream and the statistics.
+pub struct Cx<'a> {
+    pub scene: &'a Scene,
+    pub channel: usize,
+    pub sampler: &'a mut Sampler,
+    pub stats: &'a mut LocalStats,
+}
+
 /// What the path loop asks of its estimator at each event (`volpath`: [`Beta`]; `volpathmis`: its
 /// spectral-MIS densities). Each method draws exactly the samples its estimator draws.
 pub trait PathWeight {
@@ -137,14 +146,11 @@ pub trait PathWeight {
     #[allow(clippy::too_many_arguments)]
     fn medium_emitter_sampling(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         m: &Homogeneous,
         p: Vec3,
         wi: Vec3,
         medium: Option<u32>,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
     ) -> Spectrum;
     /// Phase sampling gave `(weight, pdf)`; `false` ends the path.
     fn phase_sampled(&mut self, phase_weight: f32, phase_pdf: f32) -> bool;
@@ -152,26 +158,21 @@ pub trait PathWeight {
     #[allow(clippy::too_many_arguments)]
     fn emitter_hit(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         hit: &EmitterHit,
         ray_d: Vec3,
         count_direct: bool,
         snee: Option<&SneeStage>,
-        channel: usize,
-        stats: &mut LocalStats,
     ) -> Spectrum;
     /// Emitter sampling at a surface `s` with a smooth BSDF: its contribution.
     #[allow(clippy::too_many_arguments)]
     fn surface_emitter_sampling(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         s: &SurfaceInteraction,
         bsdf: &Bsdf,
         medium: Option<u32>,
         snee: Option<&SneeStage>,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
     ) -> Spectrum;
     /// Is this BSDF sample usable? (Else the path ends, as a failed sample does.)
     fn accepts(&self, bs: &BsdfSample) -> bool;
@@ -229,15 +230,14 @@ impl PathWeight for Beta {
     #[inline]
     fn medium_emitter_sampling(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         m: &Homogeneous,
         p: Vec3,
         wi: Vec3,
         medium: Option<u32>,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
     ) -> Spectrum {
+        let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
+
         if !m.sample_emitters {
             return Spectrum::ZERO;
         }
@@ -263,14 +263,14 @@ impl PathWeight for Beta {
     #[inline]
     fn emitter_hit(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         hit: &EmitterHit,
         ray_d: Vec3,
         count_direct: bool,
         snee: Option<&SneeStage>,
-        channel: usize,
-        stats: &mut LocalStats,
     ) -> Spectrum {
+        let (scene, channel, stats) = (cx.scene, cx.channel, &mut *cx.stats);
+
         // An emitter with zero radiance toward us is no hit (nor a suffix for SNEE to weigh).
         if hit.le == Spectrum::ZERO {
             return Spectrum::ZERO;
@@ -289,15 +289,14 @@ impl PathWeight for Beta {
     #[inline]
     fn surface_emitter_sampling(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         s: &SurfaceInteraction,
         bsdf: &Bsdf,
         medium: Option<u32>,
         snee: Option<&SneeStage>,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
     ) -> Spectrum {
+        let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
+
         if scene.emitters.is_empty() {
             return Spectrum::ZERO;
         }
@@ -398,7 +397,7 @@ pub fn trace<W: PathWeight>(
                 specular_chain = !m.sample_emitters;
 
                 // ---- Emitter sampling at the medium vertex ----
-                let c = weight.medium_emitter_sampling(scene, m, p, wi, medium, channel, sampler, stats);
+                let c = weight.medium_emitter_sampling(&mut Cx { scene, channel, sampler, stats }, m, p, wi, medium);
                 if keep_all {
                     result += c;
                 }
@@ -450,14 +449,26 @@ pub fn trace<W: PathWeight>(
             _ => None,
         };
         if let (false, Some(hit)) = (hide, hit) {
-            result += weight.emitter_hit(scene, &hit, ray.d, count_direct, snee.as_ref(), channel, stats);
+            result += weight.emitter_hit(
+                &mut Cx { scene, channel, sampler, stats },
+                &hit,
+                ray.d,
+                count_direct,
+                snee.as_ref(),
+            );
         }
         let Some(s) = si else { break };
         let bsdf = scene.bsdf(&s);
 
         // ---- Emitter sampling at the surface ----
         if bsdf.flags() & flags::SMOOTH != 0 && depth + 1 < max_depth {
-            result += weight.surface_emitter_sampling(scene, &s, bsdf, medium, snee.as_ref(), channel, sampler, stats);
+            result += weight.surface_emitter_sampling(
+                &mut Cx { scene, channel, sampler, stats },
+                &s,
+                bsdf,
+                medium,
+                snee.as_ref(),
+            );
         }
 
         // ---- BSDF sampling ----

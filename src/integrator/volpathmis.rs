@@ -45,7 +45,7 @@
 
 use super::snee::SneeStage;
 use super::stats::LocalStats;
-use super::volpath::{trace, EmitterHit, PathWeight};
+use super::volpath::{trace, Cx, EmitterHit, PathWeight};
 use super::walk::{shadow_ray, walk_segments, PathSetup, RefPoint};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample};
 use crate::color::Spectrum;
@@ -264,15 +264,14 @@ impl PathWeight for SpectralMis {
     #[inline]
     fn medium_emitter_sampling(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         m: &Homogeneous,
         p: Vec3,
         wi: Vec3,
         medium: Option<u32>,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
     ) -> Spectrum {
+        let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
+
         let mut c = Spectrum::ZERO;
         if m.sample_emitters {
             let (mut nee_end, mut uni_end, emitted, ds) =
@@ -298,14 +297,14 @@ impl PathWeight for SpectralMis {
     #[inline]
     fn emitter_hit(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         hit: &EmitterHit,
         _ray_d: Vec3,
         count_direct: bool,
         _snee: Option<&SneeStage>,
-        _channel: usize,
-        _stats: &mut LocalStats,
     ) -> Spectrum {
+        let scene = cx.scene;
+
         let w = if count_direct {
             self.p_over_f.weight()
         } else {
@@ -319,15 +318,14 @@ impl PathWeight for SpectralMis {
     #[inline]
     fn surface_emitter_sampling(
         &mut self,
-        scene: &Scene,
+        cx: &mut Cx,
         s: &SurfaceInteraction,
         bsdf: &Bsdf,
         medium: Option<u32>,
         _snee: Option<&SneeStage>,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
     ) -> Spectrum {
+        let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
+
         let (mut nee_end, mut uni_end, emitted, ds) =
             sample_emitter(scene, RefPoint::Surface(s), medium, &self.p_over_f, channel, sampler, stats);
         if emitted == Spectrum::ZERO {

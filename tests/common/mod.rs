@@ -1,11 +1,13 @@
-//! Helpers shared by the `snee_*` tests: scenes from XML text, renders in independent batches,
-//! and a Welch t-test on batch means with Šidák's correction.
+//! Helpers shared by the integration tests: scenes from XML text, renders in independent batches,
+//! and a Welch t-test on batch means with Šidák's correction (Student's t and Šidák from
+//! `snee::testing`, so no test re-implements them).
 #![allow(dead_code, clippy::needless_range_loop)]
 
 use snee::render::{render, RenderOptions};
 use snee::scene::build::build_scene;
 use snee::scene::world::Scene;
 use snee::scene::xml::parse_str;
+pub use snee::testing::chi2::sidak;
 pub use snee::testing::student_t::t_p_value;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -64,7 +66,8 @@ pub fn render_batches(scene: &Scene, batches: usize, spp: u32, block: usize, see
     out
 }
 
-fn mean_var(v: &[f64]) -> (f64, f64) {
+/// Sample mean and (unbiased) variance.
+pub fn mean_var(v: &[f64]) -> (f64, f64) {
     let n = v.len() as f64;
     let m = v.iter().sum::<f64>() / n;
     (m, v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0))
@@ -75,7 +78,7 @@ fn mean_var(v: &[f64]) -> (f64, f64) {
 pub fn welch_compare(a: &Batches, b: &Batches, alpha: f64) -> (String, [f64; 3], [f64; 3]) {
     let n_stats = a.stats[0].len();
     let tests = n_stats * 3;
-    let level = 1.0 - (1.0 - alpha).powf(1.0 / tests as f64);
+    let level = sidak(alpha, tests);
     let mut report = String::new();
     let mut means = ([0.0; 3], [0.0; 3]);
     for s in 0..n_stats {
@@ -111,4 +114,50 @@ pub fn rel_std_error(a: &Batches) -> f64 {
     let v: Vec<f64> = a.stats.iter().map(|x| (x[0][0] + x[0][1] + x[0][2]) / 3.0).collect();
     let (m, var) = mean_var(&v);
     (var / v.len() as f64).sqrt() / m.abs().max(1e-300)
+}
+
+/// A 1×1 film's reading (e.g. an `irradiancemeter`) over `batches` renders with seeds `seed0`,
+/// `seed0 + 1`, ...: (mean, standard error of the mean, rejected samples).
+pub fn meter_reading(scene: &Scene, spp: u32, batches: u64, seed0: u64) -> (f64, f64, u64) {
+    let cancel = AtomicBool::new(false);
+    let mut v = Vec::new();
+    let mut rejected = 0;
+    for b in 0..batches {
+        let opts = RenderOptions { spp: Some(spp), seed: seed0 + b, time_budget: None, progress: false };
+        let out = render(scene, &opts, &cancel);
+        rejected += out.stats.rejected_samples;
+        v.push(out.data[0] as f64);
+    }
+    let (m, var) = mean_var(&v);
+    (m, (var / v.len() as f64).sqrt(), rejected)
+}
+
+/// A slab 200 mean free paths wide and 100 deep (σt = 1, albedo `albedo`, HG `g`), its top face at
+/// z = 0, bounded by the BSDF `boundary` (XML), under a directional beam travelling along −z, read
+/// by an `irradiancemeter` on a 10×10 `null` quad facing down just above it.
+pub fn slab_xml(integrator: &str, albedo: f64, g: f64, boundary: &str) -> String {
+    let phase = if g == 0.0 {
+        r#"<phase type="isotropic"/>"#.to_string()
+    } else {
+        format!(r#"<phase type="hg"><float name="g" value="{g}"/></phase>"#)
+    };
+    format!(
+        r#"<scene version="3.0.0">
+    <integrator type="{integrator}"><integer name="max_depth" value="-1"/></integrator>
+    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
+    <medium type="homogeneous" id="slab"><float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>{phase}</medium>
+    <shape type="cube">
+        <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
+        {boundary}
+        <ref name="interior" id="slab"/>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world"><scale value="5"/><rotate x="1" angle="180"/><translate z="0.01"/></transform>
+        <bsdf type="null"/>
+        <sensor type="irradiancemeter">
+            <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
+        </sensor>
+    </shape>
+</scene>"#
+    )
 }
