@@ -23,10 +23,10 @@
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
 use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, PathSetup, RefPoint, MAX_SEGMENTS};
-use crate::interaction::offset_origin;
 use crate::bsdf::{flags, BsdfContext};
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::color::Spectrum;
+use crate::interaction::offset_origin;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::Vec3;
 use crate::math::{mis_weight, Ray};
