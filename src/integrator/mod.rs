@@ -18,6 +18,7 @@
 //! | `hide_emitters` | boolean | false   | emitters seen directly are black                       |
 
 pub mod desc;
+pub mod enclosure;
 pub mod moment;
 pub mod path;
 pub mod snee;

@@ -22,10 +22,11 @@
 
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
-use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, walk_segments, PathSetup, RefPoint};
+use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, PathSetup, RefPoint, MAX_SEGMENTS};
 use crate::bsdf::{flags, BsdfContext};
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::color::Spectrum;
+use crate::interaction::offset_origin;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::Vec3;
 use crate::math::{mis_weight, Ray};
@@ -52,40 +53,71 @@ pub fn sample_emitter(
     (emitted * tr, ds)
 }
 
+/// [`sample_emitter`] from a medium point `p` where it is known to return 0 (a medium whose
+/// enclosure blocks every shadow ray, `integrator/enclosure.rs`): no ray is traced, but the same
+/// samples are drawn: the emitter sample, and when it is usable the one distance sample of the
+/// segment to the enclosing surface (which either ends it by a collision or blocks it).
+#[inline]
+pub fn skip_sample_emitter(scene: &Scene, p: Vec3, sampler: &mut Sampler) {
+    let (ds, emitted) = scene.sample_emitter_direction(p, None, sampler.next_2d(), false);
+    if ds.pdf != 0.0 && emitted != Spectrum::ZERO {
+        let _ = sampler.next_1d();
+    }
+}
+
 /// Transmittance along a shadow ray up to `ray.tmax`, through null / thin-dielectric interfaces
 /// and homogeneous media (track-length estimate in `channel`, as Mitsuba's RGB mode does).
+///
+/// Distance first, as Mitsuba: in a medium the free-flight distance `t` is sampled before the
+/// segment is traced, and the ray is traced only up to `t` (a surface hit before it ends the
+/// segment; none means a real collision, and a homogeneous medium, without null density, gives 0).
+/// The walk is `walk_segments`'s, with the same samples in the same order.
 pub fn shadow_transmittance(
     scene: &Scene,
-    ray: Ray,
-    medium: Option<u32>,
+    mut ray: Ray,
+    mut medium: Option<u32>,
     channel: usize,
     sampler: &mut Sampler,
     stats: &mut LocalStats,
 ) -> Spectrum {
     let mut tr = Spectrum::ONE;
-    walk_segments(scene, ray, medium, stats, |medium, seg, si| {
-        if let Some(m) = medium {
-            let m = &scene.media[m as usize];
-            let t = m.sample_distance(sampler.next_1d(), channel);
+    let mut remaining = ray.tmax;
+    for _ in 0..MAX_SEGMENTS {
+        if !(remaining > 0.0) {
+            break;
+        }
+        let m = medium.map(|m| &scene.media[m as usize]);
+        let t = m.map_or(f32::INFINITY, |m| m.sample_distance(sampler.next_1d(), channel));
+        // Up to and including `t`: a surface exactly at `t` is crossed, as with `t < seg` below.
+        ray.tmax = if t < remaining { t.next_up() } else { remaining };
+        stats.rays += 1;
+        let si = scene.ray_intersect(&ray);
+        let seg = si.as_ref().map_or(remaining, |s| s.t);
+        if let Some(m) = m {
             if t < seg {
                 // A real collision: homogeneous media have no null density, the estimate is 0.
-                tr = Spectrum::ZERO;
-                return false;
+                return Spectrum::ZERO;
             }
             if seg.is_finite() {
                 let t_seg = m.transmittance(seg);
                 let p = t_seg[channel];
                 if !(p > 0.0) {
-                    tr = Spectrum::ZERO;
-                    return false;
+                    return Spectrum::ZERO;
                 }
                 tr *= t_seg / p;
             }
         }
-        let Some(si) = si else { return false };
-        tr *= scene.bsdf(si).eval_null_transmission(si);
-        tr != Spectrum::ZERO
-    });
+        let Some(si) = si else { break };
+        tr *= scene.bsdf(&si).eval_null_transmission(&si);
+        if tr == Spectrum::ZERO {
+            break;
+        }
+        if is_medium_transition(scene, &si) {
+            medium = target_medium(scene, &si, ray.d);
+        }
+        remaining -= si.t;
+        ray.o = offset_origin(si.p, si.n, ray.d);
+    }
     tr
 }
 
@@ -239,6 +271,10 @@ impl PathWeight for Beta {
         let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
 
         if !m.sample_emitters {
+            return Spectrum::ZERO;
+        }
+        if medium.is_some_and(|mi| scene.emitters_unreachable[mi as usize]) {
+            skip_sample_emitter(scene, p, sampler);
             return Spectrum::ZERO;
         }
         let (emitted, ds) = sample_emitter(scene, RefPoint::Medium(p), medium, channel, sampler, stats);

@@ -166,7 +166,9 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         // Replaced below: the integrator's tables are built from the finished scene.
         integrator: Integrator::Path(IntegratorDesc::default()),
         bounds,
+        emitters_unreachable: Vec::new(),
     };
+    scene.emitters_unreachable = integrator::enclosure::emitters_unreachable(&scene);
     scene.integrator = integrator::build(integrator, &scene);
     Ok(scene)
 }

@@ -43,6 +43,8 @@ pub struct Scene {
     /// The integrator, built with its tables at scene load.
     pub integrator: Integrator,
     pub bounds: Aabb,
+    /// Per medium: emitter sampling from inside it always returns 0 (`integrator/enclosure.rs`).
+    pub emitters_unreachable: Vec<bool>,
 }
 
 impl Scene {

@@ -1,0 +1,81 @@
+//! The medium emitter-sampling skip (`integrator/enclosure.rs`): which media of the repository's
+//! scenes qualify, and that where one does, the full shadow-ray estimate is exactly 0 and consumes
+//! exactly the samples the skip draws (so skipping keeps the random-number stream).
+
+use snee::integrator::stats::LocalStats;
+use snee::integrator::volpath::{sample_emitter, skip_sample_emitter};
+use snee::integrator::walk::RefPoint;
+use snee::math::Vec3;
+use snee::sampler::Sampler;
+use snee::scene::build::build_scene;
+use snee::scene::world::Scene;
+use snee::scene::xml::parse_file;
+use snee::shape::Geometry;
+use std::path::Path;
+
+fn load(file: &str) -> Scene {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let parsed = parse_file(&dir.join(file), &[]).unwrap_or_else(|e| panic!("{}", e));
+    build_scene(&parsed).unwrap_or_else(|e| panic!("{}", e))
+}
+
+#[test]
+fn qualifying_media_of_the_scenes() {
+    // Closed dielectric / roughdielectric boundaries, lights outside: emitter sampling is always 0.
+    for f in ["scenes/media_rough_glass.xml", "scenes/media_smooth_glass.xml", "scenes/media_spot.xml"] {
+        assert_eq!(load(f).emitters_unreachable, vec![true], "{f}");
+    }
+    assert_eq!(load("scenes/paper/sphere_smooth_st34.xml").emitters_unreachable, vec![true]);
+    assert_eq!(load("scenes/paper/envmap_ggx020_st02.xml").emitters_unreachable, vec![true]);
+    // Null / thin-dielectric boundaries pass shadow rays; a light and a cube inside (named as the
+    // medium's exterior); the camera inside a null sphere.
+    for f in
+        ["scenes/media_null.xml", "scenes/media_thin.xml", "scenes/media_inside.xml", "scenes/media_camera_inside.xml"]
+    {
+        assert_eq!(load(f).emitters_unreachable, vec![false], "{f}");
+    }
+}
+
+#[test]
+fn skip_draws_what_the_shadow_ray_draws() {
+    for f in ["scenes/media_rough_glass.xml", "scenes/media_thin.xml"] {
+        let scene = load(f);
+        let sphere = scene
+            .shapes
+            .iter()
+            .find_map(|s| match (&s.geometry, s.interior) {
+                (Geometry::Sphere(sp), Some(0)) => Some(sp.clone()),
+                _ => None,
+            })
+            .expect("a sphere bounding medium 0");
+        let mut points = Sampler::new(11, 0);
+        let (mut zero, mut nonzero) = (0, 0);
+        for i in 0..20_000u64 {
+            // A uniform point inside the sphere (rejection from its cube).
+            let u = Vec3::new(points.next_1d(), points.next_1d(), points.next_1d()) * 2.0 - Vec3::ONE;
+            if u.length() >= 0.999 {
+                continue;
+            }
+            let p = sphere.center + u * sphere.radius;
+            let mut full = Sampler::new(5, i);
+            let mut skip = full.clone();
+            let channel = (i % 3) as usize;
+            let mut stats = LocalStats::default();
+            let (emitted, _) = sample_emitter(&scene, RefPoint::Medium(p), Some(0), channel, &mut full, &mut stats);
+            skip_sample_emitter(&scene, p, &mut skip);
+            if emitted == snee::color::Spectrum::ZERO {
+                zero += 1;
+            } else {
+                nonzero += 1;
+            }
+            if scene.emitters_unreachable[0] {
+                assert_eq!(emitted, snee::color::Spectrum::ZERO, "{f}: nonzero estimate at {p}");
+                assert_eq!(full.next_1d(), skip.next_1d(), "{f}: sample streams diverge at {p}");
+            }
+        }
+        // The thin-dielectric sphere does not qualify, and there the estimate is often nonzero.
+        if !scene.emitters_unreachable[0] {
+            assert!(nonzero > 100, "{f}: {nonzero} nonzero of {}", zero + nonzero);
+        }
+    }
+}
