@@ -370,7 +370,6 @@ fn files(c: &Case) -> Vec<Vec<u8>> {
 static NEXT_DIR: AtomicU64 = AtomicU64::new(0);
 /// Cases whose scene built and rendered (the others stopped at an error).
 static RENDERED: AtomicU64 = AtomicU64::new(0);
-/// Renders with a non-finite second moment (see [`run_folder`]).
 
 fn write_folder(dir: &Path, files: &[Vec<u8>]) {
     std::fs::create_dir_all(dir).unwrap();
