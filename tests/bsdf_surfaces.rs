@@ -6,12 +6,12 @@
 
 use snee::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use snee::color::Spectrum;
-use snee::interaction::SurfaceInteraction;
-use snee::math::{DVec3, Frame, Vec2, Vec3};
+use snee::math::{DVec3, Vec2, Vec3};
 use snee::scene::desc::{ObjectDesc, PluginKind, Props, Value};
 use snee::scene::resolver::FileResolver;
 use snee::scene::SrcPos;
 use snee::testing::chi2::{chi2_sphere, sidak};
+use snee::testing::{si_with_wi, sph};
 use std::rc::Rc;
 
 fn pos() -> SrcPos {
@@ -49,24 +49,6 @@ fn desc_from_json(cfg: &serde_json::Value) -> ObjectDesc {
 fn load(plugin: &str, props: Vec<(&str, Value)>) -> Bsdf {
     let props = props.into_iter().map(|(n, v)| (n.to_string(), v)).collect();
     Bsdf::from_desc(&desc(plugin, props), &FileResolver::default()).unwrap()
-}
-
-fn si_with_wi(wi: Vec3) -> SurfaceInteraction {
-    SurfaceInteraction {
-        t: 1.0,
-        p: Vec3::ZERO,
-        n: Vec3::Z,
-        sh_frame: Frame::from_normal(Vec3::Z),
-        uv: Vec2::splat(0.5),
-        wi,
-        shape: 0,
-        prim: 0,
-    }
-}
-
-fn sph(theta_deg: f32, phi_deg: f32) -> Vec3 {
-    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
-    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
 }
 
 fn v3(v: &serde_json::Value) -> Vec3 {

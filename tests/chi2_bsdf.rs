@@ -12,13 +12,13 @@
 
 use snee::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use snee::color::{luminance, Spectrum};
-use snee::interaction::SurfaceInteraction;
-use snee::math::{Frame, Vec2, Vec3};
+use snee::math::{Vec2, Vec3};
 use snee::sampler::Sampler;
 use snee::scene::desc::{ObjectDesc, PluginKind, Props, Value};
 use snee::scene::resolver::FileResolver;
 use snee::scene::SrcPos;
 use snee::testing::chi2::{chi2_discrete, chi2_sphere, sidak};
+use snee::testing::{si_with_wi, sph};
 use std::rc::Rc;
 
 // ---- Construction helpers ----
@@ -53,24 +53,6 @@ fn rough(ggx: bool, alpha_u: f32, alpha_v: f32, int_ior: f32, ext_ior: f32, visi
         p.push(("alpha_v", Value::Float(alpha_v as f64)));
     }
     load("roughdielectric", p)
-}
-
-fn si_with_wi(wi: Vec3) -> SurfaceInteraction {
-    SurfaceInteraction {
-        t: 1.0,
-        p: Vec3::ZERO,
-        n: Vec3::Z,
-        sh_frame: Frame::from_normal(Vec3::Z),
-        uv: Vec2::splat(0.5),
-        wi,
-        shape: 0,
-        prim: 0,
-    }
-}
-
-fn sph(theta_deg: f32, phi_deg: f32) -> Vec3 {
-    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
-    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
 }
 
 fn v3(a: [f32; 3]) -> Vec3 {

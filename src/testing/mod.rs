@@ -3,3 +3,27 @@
 
 pub mod chi2;
 pub mod student_t;
+
+use crate::interaction::SurfaceInteraction;
+use crate::math::{Frame, Vec2, Vec3};
+
+/// A surface interaction at the origin with normal +Z and the local shading frame equal to the
+/// world frame, seen from `wi` (for BSDF tests that evaluate and sample in the local frame).
+pub fn si_with_wi(wi: Vec3) -> SurfaceInteraction {
+    SurfaceInteraction {
+        t: 1.0,
+        p: Vec3::ZERO,
+        n: Vec3::Z,
+        sh_frame: Frame::from_normal(Vec3::Z),
+        uv: Vec2::splat(0.5),
+        wi,
+        shape: 0,
+        prim: 0,
+    }
+}
+
+/// The unit direction at polar angle `theta_deg` from +Z and azimuth `phi_deg` (degrees).
+pub fn sph(theta_deg: f32, phi_deg: f32) -> Vec3 {
+    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+    Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
+}
