@@ -81,6 +81,8 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
     let b = scene.bounds;
     let bounds = if b.is_empty() { Json::Null } else { json!({"min": b.min.to_array(), "max": b.max.to_array()}) };
     let integ = &scene.integrator;
+    // volpath_snee: which estimator runs (the paper's, or the complete one with manifold NEE).
+    let connection = (integ.kind == crate::integrator::IntegratorKind::VolpathSnee).then(|| integ.connection.name());
     let json = json!({
         "plugins": tree_json(&parsed.root),
         "shapes": scene.shapes.len(),
@@ -91,7 +93,7 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         "film": {"width": film.width, "height": film.height, "crop_offset": [film.crop_offset.0, film.crop_offset.1], "crop_size": [film.crop_size.0, film.crop_size.1]},
         "spp": sampler.sample_count,
         "sampler": sampler_kind,
-        "integrator": {"type": format!("{:?}", integ.kind), "max_depth": integ.max_depth, "rr_depth": integ.rr_depth, "hide_emitters": integ.hide_emitters, "moment": integ.moment},
+        "integrator": {"type": format!("{:?}", integ.kind), "max_depth": integ.max_depth, "rr_depth": integ.rr_depth, "hide_emitters": integ.hide_emitters, "moment": integ.moment, "connection": connection},
     });
     let mut text = String::new();
     tree_text(&parsed.root, 0, &mut text);
@@ -126,11 +128,12 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
     let _ = writeln!(text, "spp: {} ({})", sampler.sample_count, sampler_kind);
     let _ = writeln!(
         text,
-        "integrator: {:?} max_depth={} rr_depth={}{}",
+        "integrator: {:?} max_depth={} rr_depth={}{}{}",
         integ.kind,
         integ.max_depth,
         integ.rr_depth,
-        if integ.moment { " (moment)" } else { "" }
+        if integ.moment { " (moment)" } else { "" },
+        connection.map_or(String::new(), |c| format!(" connection={c}"))
     );
     Summary { json, text }
 }

@@ -1,6 +1,7 @@
 //! Integrators: `path` (surfaces only), `volpath`, `volpath_snee` (volpath with subdivision NEE), and the
 //! `moment` wrapper that also outputs the per-pixel second moment.
 
+pub mod manifold;
 pub mod path;
 pub mod snee;
 pub mod stats;
@@ -31,6 +32,8 @@ pub struct IntegratorDesc {
     pub moment: bool,
     /// `volpath_snee`'s `snee` and `transport` options (defaults elsewhere).
     pub snee: SneeOptions,
+    /// `volpath_snee`'s `connection`: the paper's estimator or the complete one (manifold NEE).
+    pub connection: manifold::Connection,
 }
 
 impl Default for IntegratorDesc {
@@ -42,6 +45,7 @@ impl Default for IntegratorDesc {
             hide_emitters: false,
             moment: false,
             snee: SneeOptions::default(),
+            connection: manifold::Connection::default(),
         }
     }
 }
@@ -87,7 +91,18 @@ impl IntegratorDesc {
         }
         let hide_emitters = props.bool("hide_emitters", false)?;
         let mut snee = SneeOptions::default();
+        let mut connection = manifold::Connection::default();
         if kind == IntegratorKind::VolpathSnee {
+            connection = match props.string("connection", "paper")?.as_str() {
+                "paper" => manifold::Connection::Paper,
+                "complete" => manifold::Connection::Complete,
+                other => {
+                    return Err(props.error(
+                        "connection",
+                        format!("volpath_snee: connection = \"{}\" is not one of paper, complete", other),
+                    ))
+                }
+            };
             snee.technique = match props.string("snee", "mis")?.as_str() {
                 "mis" => SneeTechnique::Mis,
                 "snee" => SneeTechnique::Snee,
@@ -123,6 +138,7 @@ impl IntegratorDesc {
             hide_emitters,
             moment: false,
             snee,
+            connection,
         })
     }
 }

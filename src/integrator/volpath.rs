@@ -15,6 +15,7 @@
 //! - "Specular chains" (paths whose last non-null event was a delta lobe, or a medium vertex that
 //!   does not sample emitters) count an emitter they hit at full weight.
 
+use super::manifold; // manifold NEE hook
 use super::snee::{self, ForwardTechnique, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
 use super::stats::LocalStats;
 use crate::bsdf::{flags, BsdfContext};
@@ -303,6 +304,10 @@ pub fn li_with(
                     if let (Some(x_i), true) = (&snee_x_i, opts.technique != SneeTechnique::Forward) {
                         result += snee::sample(scene, x_i, beta, channel, opts.technique, sampler, stats);
                     }
+                    let x_j = manifold::MediumVertex { p, wi, medium: mi }; // manifold NEE hook
+                    let x_i = snee_chain.as_ref().map(|c| &c.0); // manifold NEE hook
+                    result += manifold::sample(scene, opts, x_i, x_j, beta, depth, max_depth, channel, sampler, stats);
+                    // manifold NEE hook
                 }
 
                 // ---- Phase function sampling ----

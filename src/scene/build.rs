@@ -169,8 +169,10 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         integrator,
         bounds,
         snee_rates: Vec::new(),
+        manifold: Vec::new(),
     };
     scene.snee_rates = crate::integrator::snee::medium_rates(&scene);
+    scene.manifold = crate::integrator::manifold::flat::flat_boundaries(&scene);
     Ok(scene)
 }
 

@@ -45,6 +45,9 @@ pub struct Scene {
     /// Per medium: `None` where SNEE does not apply, else the probability `r` that
     /// `volpath_snee` runs SNEE at one of its scattering vertices (`integrator::snee::medium_rates`).
     pub snee_rates: Vec<Option<f32>>,
+    /// Per medium: its flat smooth boundary where the manifold connection applies
+    /// (`integrator::manifold::flat::flat_boundaries`).
+    pub manifold: Vec<Option<crate::integrator::manifold::flat::FlatBoundary>>,
 }
 
 impl Scene {
