@@ -10,9 +10,10 @@
 
 use crate::bsdf::fresnel::{fresnel, refract};
 use crate::bsdf::Bsdf;
+use crate::emitter::Emitter;
 use crate::interaction::SurfaceInteraction;
 use crate::math::{Frame, Vec3};
-use crate::scene::world::Scene;
+use crate::scene::world::{Scene, SceneEmitter};
 use crate::shape::Geometry;
 
 /// Most distinct planes enumerated per connection (a cube has 6); more: the medium is not handled.
@@ -34,10 +35,13 @@ pub struct FlatBoundary {
 }
 
 /// Per medium of `scene`: its flat boundary, or `None` where the manifold connection does not
-/// apply (the medium does not sample emitters, is not enclosed by a dielectric, or some
-/// enclosing shape is curved, shading-normal interpolated, rough, or has too many orientations).
+/// apply (the scene has no directional light, the medium does not sample emitters, is not
+/// enclosed by a dielectric, or some enclosing shape is curved, shading-normal interpolated,
+/// rough, or has too many orientations). Where it is `None` the connection draws no samples, so
+/// `connection = complete` renders exactly what `paper` renders.
 pub fn flat_boundaries(scene: &Scene) -> Vec<Option<FlatBoundary>> {
-    (0..scene.media.len() as u32).map(|m| flat_boundary(scene, m)).collect()
+    let directional = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_))));
+    (0..scene.media.len() as u32).map(|m| if directional { flat_boundary(scene, m) } else { None }).collect()
 }
 
 fn flat_boundary(scene: &Scene, medium: u32) -> Option<FlatBoundary> {
