@@ -532,7 +532,7 @@ fn sample_impl(
         return Spectrum::ZERO;
     }
     let w = suffix_weights(technique, pdfs).snee;
-    let w = w * super::manifold::snee_weight(scene, technique, &suffix, &light, channel, pdfs.snee); // manifold NEE hook
+    let w = super::manifold::snee_weight(scene, technique, &suffix, &light, channel, pdfs.snee).unwrap_or(w); // manifold NEE hook
     f * (w / pdfs.snee) as f32
 }
 

@@ -232,6 +232,7 @@ pub fn li_with(
     // The suffix x_i → x_j → x_k at the current boundary vertex, and after BSDF sampling there.
     let mut snee_at_k: Option<SneeSuffix>;
     let mut snee_pending: Option<SneeSuffix> = None;
+    let mut manifold_tracker = manifold::Tracker::default(); // manifold NEE hook
 
     loop {
         // ---- Russian roulette and depth limit ----
@@ -304,9 +305,9 @@ pub fn li_with(
                     if let (Some(x_i), true) = (&snee_x_i, opts.technique != SneeTechnique::Forward) {
                         result += snee::sample(scene, x_i, beta, channel, opts.technique, sampler, stats);
                     }
-                    let x_j = manifold::MediumVertex { p, wi, medium: mi }; // manifold NEE hook
-                    let x_i = snee_chain.as_ref().map(|c| &c.0); // manifold NEE hook
-                    result += manifold::sample(scene, opts, x_i, x_j, beta, depth, max_depth, channel, sampler, stats);
+                    let (x_j, x_i) = (manifold::MediumVertex { p, wi, medium: mi }, snee_chain.as_ref().map(|c| &c.0)); // manifold NEE hook
+                    result +=
+                        manifold_tracker.sample(scene, opts, x_i, x_j, beta, depth, max_depth, channel, sampler, stats);
                     // manifold NEE hook
                 }
 
@@ -339,6 +340,7 @@ pub fn li_with(
             _ => None,
         };
         let pending = snee_pending.take();
+        let manifold_pending = manifold_tracker.surface_event(); // manifold NEE hook
 
         // ---- Emitters hit by the ray (area lights, or the environment on escape) ----
         let count_direct = depth == 0 || specular_chain;
@@ -369,6 +371,9 @@ pub fn li_with(
                 le: Spectrum::ZERO,
             };
             let w = suffix_weight(scene, snee, pending.as_ref(), light, ForwardTechnique::Bsdf, w, channel, stats);
+            let (mp, escaped) = (manifold_pending.as_ref(), si.is_none()); // manifold NEE hook
+            let w = manifold::forward_weight(scene, snee, mp, pending.as_ref(), escaped, ray.d, channel, stats)
+                .unwrap_or(w); // manifold NEE hook
             result += beta * le * w;
         }
         let Some(s) = si else { break };
@@ -424,6 +429,7 @@ pub fn li_with(
         if bs.sampled_type & flags::SMOOTH != 0 {
             specular_chain = false;
         }
+        manifold_tracker.after_bsdf(scene, &s, bs.sampled_type, wo, manifold_pending); // manifold NEE hook
         if is_medium_transition(scene, &s) {
             medium = target_medium(scene, &s, wo);
         }

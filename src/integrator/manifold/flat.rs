@@ -35,12 +35,15 @@ pub struct FlatBoundary {
 }
 
 /// Per medium of `scene`: its flat boundary, or `None` where the manifold connection does not
-/// apply (the scene has no directional light, the medium does not sample emitters, is not
+/// apply (the scene has neither a directional light nor an environment, the medium does not sample emitters, is not
 /// enclosed by a dielectric, or some enclosing shape is curved, shading-normal interpolated,
 /// rough, or has too many orientations). Where it is `None` the connection draws no samples, so
 /// `connection = complete` renders exactly what `paper` renders.
 pub fn flat_boundaries(scene: &Scene) -> Vec<Option<FlatBoundary>> {
-    let directional = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_))));
+    let directional = scene.emitters.iter().any(|e| match e {
+        SceneEmitter::Other(e) => matches!(e, Emitter::Directional(_)) || e.is_environment(),
+        SceneEmitter::Area { .. } => false,
+    });
     (0..scene.media.len() as u32).map(|m| if directional { flat_boundary(scene, m) } else { None }).collect()
 }
 
@@ -144,8 +147,8 @@ mod tests {
             let omega_l =
                 (plane.n + Vec3::new(a.cos(), a.sin(), 0.5 * (2.0 * a).sin()) * (k as f32 * 0.05)).normalize();
             let Some(r) = refract_into(&plane, omega_l) else { continue };
-            let sin_l = (1.0 - (r.cos_l as f64).powi(2)).sqrt();
-            let sin_in = (1.0 - (r.cos_in as f64).powi(2)).sqrt();
+            let sin_l = (1.0 - (r.cos_l as f64).powi(2)).max(0.0).sqrt();
+            let sin_in = (1.0 - (r.cos_in as f64).powi(2)).max(0.0).sqrt();
             assert!((sin_l - 1.33 * sin_in).abs() < 1e-5, "{sin_l} vs 1.33 · {sin_in}");
             // omega_l, omega_in and n are coplanar.
             assert!(plane.n.cross(omega_l).dot(r.omega_in).abs() < 1e-5);

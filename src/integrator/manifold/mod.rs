@@ -22,7 +22,9 @@
 //! and [`snee_weight`] for SNEE's side of the MIS.
 
 pub mod flat;
+pub mod mis;
 pub mod pdf;
+pub mod track;
 
 use super::snee::{self, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeTransport, SneeVertex};
 use super::stats::LocalStats;
@@ -32,6 +34,7 @@ use crate::math::{Ray, Vec2, Vec3};
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
 use flat::{on_plane, refract_into, Plane, Refraction};
+pub use track::Tracker;
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -106,11 +109,12 @@ fn light_segment(scene: &Scene, si_k: &SurfaceInteraction, omega_l: Vec3, stats:
     Spectrum::ZERO
 }
 
-/// Solve the connection from `x_j` through `plane` to a directional light in direction
-/// `omega_l` (unit, towards the light) with `weight = E / p_sel`: refract, trace back from `x_j`
-/// along `−omega_in`, verify the first hit lies on that plane of the enclosing boundary, and the
-/// light segment. Counts solutions and failed candidates.
-pub fn connect_directional(
+/// Solve the connection from `x_j` through `plane` to a light in the fixed direction `omega_l`
+/// (unit, towards the light: a directional light with `weight = E / p_sel`, or a sampled
+/// environment direction with `weight = L / p_env`): refract, trace back from `x_j` along
+/// `−omega_in`, verify the first hit lies on that plane of the enclosing boundary, and the light
+/// segment. The value is the same for both (docs/manifold.md §3). Counts solutions and failures.
+pub fn connect(
     scene: &Scene,
     x_j: &MediumVertex,
     plane: &Plane,
@@ -147,8 +151,9 @@ pub fn connect_directional(
 
 /// The manifold stage at a real scatter `x_j` (depth `depth`, throughput `beta` including
 /// `sigma_s`): one emitter sample, every plane's solution, each MIS-weighted against SNEE run at
-/// the previous vertex `x_i` (when that was a SNEE vertex and no surface event came between).
-/// Consumes one 2-D sample whenever it runs (`connection = complete` and the medium is flat).
+/// the previous vertex `x_i` (when that was a SNEE vertex and no surface event came between) and,
+/// for an environment, against forward tracing. `None` when the connection does not run here
+/// (then its density is 0 for suffixes from `x_j`); it draws one 2-D sample whenever it runs.
 #[allow(clippy::too_many_arguments)]
 pub fn sample(
     scene: &Scene,
@@ -161,28 +166,50 @@ pub fn sample(
     channel: usize,
     sampler: &mut Sampler,
     stats: &mut LocalStats,
-) -> Spectrum {
+) -> Option<Spectrum> {
     if !enabled(scene) {
-        return Spectrum::ZERO;
+        return None;
     }
-    let Some(Some(boundary)) = scene.manifold.get(x_j.medium as usize) else { return Spectrum::ZERO };
+    let Some(Some(boundary)) = scene.manifold.get(x_j.medium as usize) else { return None };
     let u: Vec2 = sampler.next_2d();
     // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).
     if depth.saturating_add(1) >= max_depth {
-        return Spectrum::ZERO;
+        return None;
     }
     stats.manifold_attempts += 1;
     let (ds, weight) = scene.sample_emitter_direction(x_j.p, None, u, false);
-    // Directional lights only (docs/manifold.md §6): delta, infinitely far.
-    if !(ds.pdf > 0.0) || !ds.delta || ds.dist.is_finite() || weight == Spectrum::ZERO {
-        return Spectrum::ZERO;
+    // Directional lights (delta, infinitely far) and environments (non-delta, infinitely far).
+    if !(ds.pdf > 0.0) || ds.dist.is_finite() || weight == Spectrum::ZERO {
+        return Some(Spectrum::ZERO);
+    }
+    let environment = !ds.delta;
+    if environment && scene.environment != Some(ds.emitter) {
+        return Some(Spectrum::ZERO);
     }
     let mut result = Spectrum::ZERO;
     for plane in &boundary.planes {
-        let Some(c) = connect_directional(scene, &x_j, plane, ds.d, weight, stats) else { continue };
-        let light =
-            LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: true, le: Spectrum::ZERO };
-        let w = weight_against_snee(scene, opts, x_i, &x_j, &c.suffix, &light, channel, stats);
+        let Some(c) = connect(scene, &x_j, plane, ds.d, weight, stats) else { continue };
+        let w = if environment {
+            let Some(light) = mis::env_light(scene, &c.suffix.si_k, ds.d) else { continue };
+            let p = mis::env_pdfs(
+                scene,
+                opts,
+                x_i,
+                &x_j,
+                &c.suffix.si_k,
+                plane,
+                &c.suffix.refraction,
+                &light,
+                channel,
+                true,
+                stats,
+            );
+            mis::env_weight(opts, mis::EnvTechnique::Manifold, p)
+        } else {
+            let light =
+                LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: true, le: Spectrum::ZERO };
+            weight_against_snee(scene, opts, x_i, &x_j, &c.suffix, &light, channel, stats)
+        };
         let contribution = beta * c.value * w as f32;
         if crate::color::is_finite(contribution) {
             result += contribution;
@@ -190,7 +217,57 @@ pub fn sample(
             stats.rejected_samples += 1;
         }
     }
-    result
+    Some(result)
+}
+
+impl Tracker {
+    /// [`sample`], remembering `x_j` when the connection ran there (for forward paths' weights).
+    #[allow(clippy::too_many_arguments)]
+    pub fn sample(
+        &mut self,
+        scene: &Scene,
+        opts: SneeOptions,
+        x_i: Option<&SneeVertex>,
+        x_j: MediumVertex,
+        beta: Spectrum,
+        depth: u32,
+        max_depth: u32,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        let r = sample(scene, opts, x_i, x_j, beta, depth, max_depth, channel, sampler, stats);
+        self.x_j = r.map(|_| x_j);
+        r.unwrap_or(Spectrum::ZERO)
+    }
+}
+
+/// The weight of a forward path that escaped to the environment along `omega_l` right after
+/// leaving `x_j`'s medium through a flat plane (`pending`), against the manifold connection and
+/// SNEE (docs/manifold.md §4.2); `None` where the manifold connection cannot make the path (the
+/// caller's weight stands). `snee_pending`: SNEE's record of the same path, when `x_i` was a
+/// SNEE vertex.
+#[allow(clippy::too_many_arguments)]
+pub fn forward_weight(
+    scene: &Scene,
+    opts: Option<SneeOptions>,
+    pending: Option<&track::Pending>,
+    snee_pending: Option<&SneeSuffix>,
+    escaped: bool,
+    omega_l: Vec3,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<f32> {
+    let (opts, pending) = (opts?, pending?);
+    if !escaped || !enabled(scene) {
+        return None;
+    }
+    let light = mis::env_light(scene, &pending.si_k, omega_l)?;
+    let r = refract_into(&pending.plane, omega_l)?;
+    let x_i = snee_pending.filter(|s| s.x_j == pending.x_j.p).map(|s| &s.x_i);
+    let p =
+        mis::env_pdfs(scene, opts, x_i, &pending.x_j, &pending.si_k, &pending.plane, &r, &light, channel, true, stats);
+    Some(mis::env_weight(opts, mis::EnvTechnique::Forward, p) as f32)
 }
 
 /// The manifold connection's MIS weight for a suffix it made at `x_j` (docs/manifold.md §4).
@@ -252,10 +329,10 @@ fn snee_density(
     pdf::snee_density(pdf_snee, s.d_jk, ratio)
 }
 
-/// SNEE's MIS weight against the manifold connection for a suffix SNEE made (1 where the
-/// manifold connection cannot make it). Only directional lights behind a flat smooth boundary are
-/// shared, and forward tracing cannot make those suffixes, so this two-way power heuristic is the
-/// full one there (docs/manifold.md §4).
+/// SNEE's full MIS weight for a suffix SNEE made that the manifold connection can also make, or
+/// `None` (SNEE's own weight stands). Directional light: only SNEE and the manifold connection
+/// make it (forward tracing cannot), two-way power heuristic in `dt dA(x_k)`; environment: the
+/// three-way weight of [`mis::env_weight`].
 pub fn snee_weight(
     scene: &Scene,
     technique: SneeTechnique,
@@ -263,27 +340,32 @@ pub fn snee_weight(
     light: &LightSample,
     channel: usize,
     pdf_snee: f64,
-) -> f64 {
-    if !enabled(scene) || !light.delta || light.dist.is_finite() {
-        return 1.0;
+) -> Option<f64> {
+    if !enabled(scene) || light.dist.is_finite() {
+        return None;
     }
-    let Some(Some(boundary)) = scene.manifold.get(s.x_i.medium as usize) else { return 1.0 };
+    let boundary = scene.manifold.get(s.x_i.medium as usize)?.as_ref()?;
     let si_k = &s.si_k;
-    let Some(plane) = boundary.planes.iter().find(|p| {
-        si_k.n.dot(p.n) > flat::SAME_NORMAL
-            && matches!(scene.bsdf(si_k), crate::bsdf::Bsdf::Dielectric(b) if b.eta == p.eta)
-    }) else {
-        return 1.0;
-    };
-    let Some(r) = refract_into(plane, light.omega_l) else { return 1.0 };
-    // The manifold connection runs at x_j if x_j's depth leaves room for x_k: the same condition
-    // as x_i being a SNEE vertex, which it is here.
+    let crate::bsdf::Bsdf::Dielectric(d) = scene.bsdf(si_k) else { return None };
+    let plane = boundary.planes.iter().find(|p| si_k.n.dot(p.n) > flat::SAME_NORMAL && d.eta == p.eta)?;
+    let r = refract_into(plane, light.omega_l)?;
     let m = &scene.media[s.x_i.medium as usize];
     let v_ij = s.x_j - s.x_i.p;
     let t_ij = v_ij.length();
+    if !light.delta {
+        scene.environment?;
+        let opts = SneeOptions { technique, ..scene.integrator.snee };
+        let x_j = MediumVertex { p: s.x_j, wi: -v_ij / t_ij, medium: s.x_i.medium };
+        // No support check: no rays traced, nothing to count.
+        let mut no_rays = LocalStats::default();
+        let p = mis::env_pdfs(scene, opts, Some(&s.x_i), &x_j, si_k, plane, &r, light, channel, false, &mut no_rays);
+        return Some(mis::env_weight(opts, mis::EnvTechnique::Snee, p));
+    }
+    // The manifold connection runs at x_j if x_j's depth leaves room for x_k: the same condition
+    // as x_i being a SNEE vertex, which it is here.
     let p_man =
         pdf::manifold_density(light.p_light, m.phase.eval(s.x_i.wi, v_ij / t_ij), m.sigma_t[channel], t_ij, r.cos_in);
     let t_kj = (s.x_j - si_k.p).length();
     let p_snee = pdf::snee_density(pdf_snee, t_kj, pdf::solid_angle_ratio(r.cos_l, r.cos_in, plane.eta));
-    pdf::snee_weight(technique, p_snee, p_man)
+    Some(pdf::snee_weight(technique, p_snee, p_man))
 }

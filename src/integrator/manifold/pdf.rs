@@ -67,7 +67,8 @@ pub fn manifold_weight(technique: SneeTechnique, p_man: f64, p_snee: f64) -> f64
 pub fn snee_weight(technique: SneeTechnique, p_snee: f64, p_man: f64) -> f64 {
     match technique {
         SneeTechnique::Forward => 0.0,
-        SneeTechnique::Snee => 1.0,
+        SneeTechnique::Snee if p_snee > 0.0 => 1.0,
+        SneeTechnique::Snee => 0.0,
         SneeTechnique::Mis => power(p_snee, p_man),
     }
 }
