@@ -1,7 +1,7 @@
 //! Manifold next-event estimation through a flat smooth boundary (`volpath_snee`,
 //! `connection = complete`): from every real scattering vertex inside a medium enclosed by a
-//! smooth `dielectric`, connect to a directional light through the refraction at the boundary.
-//! Derivation, densities and what is left out: `docs/manifold.md`.
+//! smooth `dielectric`, connect to a directional light or an environment through the refraction
+//! at the boundary. Derivation, densities and what is left out: `docs/manifold.md`.
 //!
 //! | Parameter    | Type   | Description                                                              |
 //! |--------------|--------|--------------------------------------------------------------------------|
@@ -14,12 +14,16 @@
 //! ```
 //!
 //! Inside a refractive boundary the ordinary NEE shadow ray is always blocked and returns 0; this
-//! technique takes its place for the suffixes no forward technique can make (a delta light behind
-//! a delta interface). Scope (docs/manifold.md §6): directional lights, boundaries made of flat
-//! facets ([`flat`]); elsewhere it does nothing and `volpath_snee` is the paper's estimator.
+//! technique takes its place. Under a directional light it makes suffixes no forward technique can
+//! make (a delta light behind a delta interface) and shares V–V–S_t–L suffixes with SNEE; under an
+//! environment it also shares them with forward tracing ([`mis`]). Scope (docs/manifold.md §6):
+//! directional lights and environments, boundaries made of flat facets ([`flat`]); elsewhere it
+//! draws no samples and `volpath_snee` is the paper's estimator.
 //!
-//! The interface the volpath loop uses: [`sample`] at a medium vertex (`// manifold NEE hook`),
-//! and [`snee_weight`] for SNEE's side of the MIS.
+//! The interface the volpath loop uses (each line marked `// manifold NEE hook`): a [`Tracker`]
+//! per path, [`Tracker::sample`] at a medium vertex, [`Tracker::surface_event`] /
+//! [`Tracker::after_bsdf`] at surfaces, [`forward_weight`] for an escaping forward path, and
+//! [`snee_weight`] for SNEE's side of the MIS (one line in `snee.rs`).
 
 pub mod flat;
 pub mod mis;
