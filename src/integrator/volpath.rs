@@ -305,10 +305,10 @@ pub fn li_with(
                     if let (Some(x_i), true) = (&snee_x_i, opts.technique != SneeTechnique::Forward) {
                         result += snee::sample(scene, x_i, beta, channel, opts.technique, sampler, stats);
                     }
-                    let (x_j, x_i) = (manifold::MediumVertex { p, wi, medium: mi }, snee_chain.as_ref().map(|c| &c.0)); // manifold NEE hook
+                    // manifold NEE hook (2 lines): the connection through the boundary from x_j.
+                    let (x_j, x_i) = (manifold::MediumVertex { p, wi, medium: mi }, snee_chain.as_ref().map(|c| &c.0));
                     result +=
                         manifold_tracker.sample(scene, opts, x_i, x_j, beta, depth, max_depth, channel, sampler, stats);
-                    // manifold NEE hook
                 }
 
                 // ---- Phase function sampling ----
@@ -371,9 +371,10 @@ pub fn li_with(
                 le: Spectrum::ZERO,
             };
             let w = suffix_weight(scene, snee, pending.as_ref(), light, ForwardTechnique::Bsdf, w, channel, stats);
-            let (mp, escaped) = (manifold_pending.as_ref(), si.is_none()); // manifold NEE hook
+            // manifold NEE hook (2 lines): an escape right after leaving x_j's medium is shared with it.
+            let (mp, escaped) = (manifold_pending.as_ref(), si.is_none());
             let w = manifold::forward_weight(scene, snee, mp, pending.as_ref(), escaped, ray.d, channel, stats)
-                .unwrap_or(w); // manifold NEE hook
+                .unwrap_or(w);
             result += beta * le * w;
         }
         let Some(s) = si else { break };
