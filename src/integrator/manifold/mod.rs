@@ -194,7 +194,7 @@ pub fn sample(
     if !enabled(scene) {
         return None;
     }
-    let Some(boundary) = boundary_of(scene, x_j.medium) else { return None };
+    let boundary = boundary_of(scene, x_j.medium)?;
     let u: Vec2 = sampler.next_2d();
     // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).
     if depth.saturating_add(1) >= max_depth {
