@@ -237,6 +237,8 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         integ_json["snee"] = json!(technique);
         integ_json["transport"] = json!(transport);
         integ_json["snee_rate"] = json!(rate);
+        // Which estimator runs (the paper's, or the complete one with manifold NEE).
+        integ_json["connection"] = json!(integ.connection.name());
     }
     let json = json!({
         "plugins": tree_json(&parsed.root, None),
@@ -292,6 +294,7 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
     if let Some((technique, transport, rate)) = snee_params(integ) {
         let rate = rate.map_or_else(|| "per medium (default)".to_string(), num);
         let _ = write!(text, ", snee = {technique}, transport = {transport}, snee_rate = {rate}");
+        let _ = write!(text, ", connection = {}", integ.connection.name());
     }
     let _ = writeln!(text, "{}", if integ.moment { " (inside moment: also m2.R, m2.G, m2.B)" } else { "" });
     Summary { json, text }

@@ -13,6 +13,7 @@
 
 use crate::color::Spectrum;
 use crate::integrator::stats::{LocalStats, Stats};
+use crate::integrator::IntegratorKind;
 use crate::math::Vec2;
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
@@ -61,6 +62,11 @@ pub struct RenderStats {
     pub rejected_samples: u64,
     pub snee_attempts: u64,
     pub snee_probe_failures: u64,
+    /// Which `volpath_snee` estimator ran (`paper`, `complete`; empty for other integrators).
+    pub connection: &'static str,
+    pub manifold_attempts: u64,
+    pub manifold_solutions: u64,
+    pub manifold_failures: u64,
 }
 
 impl RenderStats {
@@ -75,6 +81,10 @@ impl RenderStats {
             "rejected_samples": self.rejected_samples,
             "snee_attempts": self.snee_attempts,
             "snee_probe_failures": self.snee_probe_failures,
+            "connection": self.connection,
+            "manifold_attempts": self.manifold_attempts,
+            "manifold_solutions": self.manifold_solutions,
+            "manifold_failures": self.manifold_failures,
         })
     }
 }
@@ -369,6 +379,14 @@ pub fn render_range(
             rejected_samples: stats.rejected_samples.load(Ordering::Relaxed),
             snee_attempts: stats.snee_attempts.load(Ordering::Relaxed),
             snee_probe_failures: stats.snee_probe_failures.load(Ordering::Relaxed),
+            connection: if scene.integrator.kind == IntegratorKind::VolpathSnee {
+                scene.integrator.connection.name()
+            } else {
+                ""
+            },
+            manifold_attempts: stats.manifold_attempts.load(Ordering::Relaxed),
+            manifold_solutions: stats.manifold_solutions.load(Ordering::Relaxed),
+            manifold_failures: stats.manifold_failures.load(Ordering::Relaxed),
         },
     }
 }

@@ -5,6 +5,7 @@
 //! `integrator/mod.rs`; parsing is in the plugin files (`integrator/mod.rs`, `moment.rs`,
 //! `volpath_snee.rs`).
 
+use super::manifold::Connection;
 use super::snee::options::{Snee, SneeOptions};
 use std::ops::{Deref, DerefMut};
 
@@ -29,6 +30,8 @@ pub struct IntegratorDesc {
     pub moment: bool,
     /// `volpath_snee`'s `snee`, `transport` and `snee_rate` options (defaults elsewhere).
     pub snee: SneeOptions,
+    /// `volpath_snee`'s `connection`: the paper's estimator or the complete one (manifold NEE).
+    pub connection: Connection,
 }
 
 impl Default for IntegratorDesc {
@@ -40,6 +43,7 @@ impl Default for IntegratorDesc {
             hide_emitters: false,
             moment: false,
             snee: SneeOptions::default(),
+            connection: Connection::default(),
         }
     }
 }
@@ -51,7 +55,8 @@ pub enum Integrator {
     Path(IntegratorDesc),
     Volpath(IntegratorDesc),
     Volpathmis(IntegratorDesc),
-    /// With SNEE's per-medium rates and emitter mixture (`snee::rate::build`).
+    /// With SNEE's per-medium rates and emitter mixture (`snee::rate::build`), and the manifold
+    /// connection's flat boundaries (`manifold::flat::flat_boundaries`).
     VolpathSnee(IntegratorDesc, Snee),
 }
 

@@ -19,6 +19,7 @@
 
 pub mod desc;
 pub mod enclosure;
+pub mod manifold;
 pub mod moment;
 pub mod path;
 pub mod snee;
@@ -67,8 +68,12 @@ pub fn parse(obj: &ObjectDesc) -> Result<IntegratorDesc> {
         return Err(props.error("rr_depth", "rr_depth must be positive"));
     }
     let hide_emitters = props.bool("hide_emitters", false)?;
-    let snee = match kind {
-        IntegratorKind::VolpathSnee => volpath_snee::parse_options(props)?,
+    let (snee, connection) = match kind {
+        IntegratorKind::VolpathSnee => {
+            // The transport branch read `connection` before the SNEE options (same error order).
+            let connection = volpath_snee::parse_connection(props)?;
+            (volpath_snee::parse_options(props)?, connection)
+        }
         _ => Default::default(),
     };
     props.finish()?;
@@ -80,6 +85,7 @@ pub fn parse(obj: &ObjectDesc) -> Result<IntegratorDesc> {
         hide_emitters,
         moment: false,
         snee,
+        connection,
     })
 }
 
@@ -90,7 +96,7 @@ pub fn build(desc: IntegratorDesc, scene: &Scene) -> Integrator {
         IntegratorKind::Volpath => Integrator::Volpath(desc),
         IntegratorKind::Volpathmis => Integrator::Volpathmis(desc),
         IntegratorKind::VolpathSnee => {
-            let snee = volpath_snee::build(scene, desc.snee);
+            let snee = volpath_snee::build(scene, desc.snee, desc.connection);
             Integrator::VolpathSnee(desc, snee)
         }
     }

@@ -14,9 +14,12 @@
 //! per-path bookkeeping (which vertices are `x_i`, `x_j`, `x_k` of the current path) lives in its
 //! own stage type, called once per loop event (`snee::stage`), never in the loop's variables.
 //!
-//! Adding a technique (e.g. manifold NEE through the boundary): implement [`Technique`] for its
-//! built tables, add its density as a field of `SuffixPdfs` and its weight to
-//! `suffix_weights`, and call its `sample` from the stage at a scatter.
+//! Adding a technique: implement [`Technique`] for its built tables, add its density as a field of
+//! `SuffixPdfs` and its weight to `suffix_weights`, and call its `sample` from the stage at a
+//! scatter. Manifold NEE through flat boundaries (`manifold/`, `connection = complete`) is a stage
+//! of its own next to SNEE's (`manifold::ManifoldStage`, tables in `Snee::flat`): it connects from
+//! `x_j` rather than `x_i`, so its densities live in another measure and its MIS weights are its
+//! own (`manifold/pdf.rs`, `manifold/mis.rs`), with one call in `snee/sample.rs` for SNEE's side.
 
 use super::snee::{self, LightSample, Snee, SneeSuffix, SneeVertex};
 use super::stats::LocalStats;

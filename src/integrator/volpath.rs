@@ -18,8 +18,10 @@
 //! The loop ([`trace`]) is shared with `volpathmis`: what differs, how the path's weight is carried
 //! and how MIS weighs emitter sampling against BSDF / phase sampling, is a [`PathWeight`]
 //! ([`Beta`] here: the throughput and the power heuristic). `volpath_snee` is this loop with SNEE
-//! as one more stage ([`SneeStage`]).
+//! as one more stage ([`SneeStage`]), and with `connection = complete` manifold NEE as another
+//! ([`ManifoldStage`], `manifold/stage.rs`).
 
+use super::manifold::ManifoldStage;
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
 use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, PathSetup, RefPoint, MAX_SEGMENTS};
@@ -195,6 +197,7 @@ pub trait PathWeight {
         ray_d: Vec3,
         count_direct: bool,
         snee: Option<&SneeStage>,
+        manifold: Option<&ManifoldStage>,
     ) -> Spectrum;
     /// Emitter sampling at a surface `s` with a smooth BSDF: its contribution.
     #[allow(clippy::too_many_arguments)]
@@ -304,6 +307,7 @@ impl PathWeight for Beta {
         ray_d: Vec3,
         count_direct: bool,
         snee: Option<&SneeStage>,
+        manifold: Option<&ManifoldStage>,
     ) -> Spectrum {
         let (scene, channel, stats) = (cx.scene, cx.channel, &mut *cx.stats);
 
@@ -318,6 +322,10 @@ impl PathWeight for Beta {
         if let Some(snee) = snee {
             let light = || LightSample::hit(ray_d, hit.light_p, hit.ds.dist, p_light());
             w = snee.weight(scene, ForwardTechnique::Bsdf, light, w, channel, stats);
+            // An escape right after leaving x_j's medium is shared with the manifold connection.
+            if let Some(wm) = manifold.and_then(|m| m.weight(scene, snee, ray_d, channel, stats)) {
+                w = wm;
+            }
         }
         self.beta * hit.le * w
     }
@@ -404,6 +412,8 @@ pub fn trace<W: PathWeight>(
     let mut needs_intersection = true;
     // Contributions outside SNEE's suffixes are dropped with transport = snee.
     let keep_all = snee.as_ref().is_none_or(|s| s.keeps_all());
+    // Manifold NEE through flat boundaries (volpath_snee with connection = complete).
+    let mut manifold = snee.as_ref().and_then(|s| ManifoldStage::new(scene, s.tables()));
 
     loop {
         // ---- Russian roulette and depth limit ----
@@ -442,6 +452,12 @@ pub fn trace<W: PathWeight>(
                 if let Some(snee) = &mut snee {
                     let beta = weight.beta();
                     result += snee.at_scatter(scene, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+
+                    // ---- Manifold next-event estimation (connection = complete) ----
+                    if let Some(manifold) = &mut manifold {
+                        result += manifold
+                            .at_scatter(scene, snee, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+                    }
                 }
 
                 // ---- Phase function sampling ----
@@ -464,6 +480,9 @@ pub fn trace<W: PathWeight>(
         needs_intersection = true;
         if let Some(snee) = &mut snee {
             snee.at_surface(scene, si.as_ref(), ray.d);
+        }
+        if let Some(manifold) = &mut manifold {
+            manifold.at_surface(si.as_ref());
         }
 
         // ---- Emitters hit by the ray (area lights, or the environment on escape) ----
@@ -491,6 +510,7 @@ pub fn trace<W: PathWeight>(
                 ray.d,
                 count_direct,
                 snee.as_ref(),
+                manifold.as_ref(),
             );
         }
         let Some(s) = si else { break };
@@ -522,6 +542,9 @@ pub fn trace<W: PathWeight>(
         weight.bsdf_sampled(&bs, bsdf_weight, non_null);
         if let Some(snee) = &mut snee {
             snee.after_bsdf(scene, &s, &bs, wo);
+        }
+        if let Some(manifold) = &mut manifold {
+            manifold.after_bsdf(scene, &s, &bs, wo);
         }
         if non_null {
             depth += 1;

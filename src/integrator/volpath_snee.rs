@@ -7,6 +7,7 @@
 //! | `max_depth`, `rr_depth`, `hide_emitters` | | as `volpath`                                |
 //! | `snee`       | string  | `mis` (default): SNEE and forward tracing by MIS; `snee`: SNEE alone where it applies; `forward`: forward alone (= volpath) |
 //! | `transport`  | string  | `all` (default); `snee`: only paths whose last two scattering vertices before leaving through the boundary are medium vertices, in SNEE's support (the paper's Figure 3) |
+//! | `connection` | string  | `paper` (default): the paper's estimator; `complete`: also manifold NEE through flat smooth boundaries (`manifold/`, docs/manifold.md) |
 //! | `snee_rate`  | float   | probability `r` of running SNEE at a scattering vertex (default: chosen per medium from its boundary and the lights, see [`snee::auto_rate`]); MIS counts SNEE's density as `r · pdf_snee`, so any `r` is unbiased |
 //!
 //! ```xml
@@ -17,6 +18,7 @@
 //! </integrator>
 //! ```
 
+use super::manifold::{self, Connection};
 use super::snee::{self, Snee, SneeOptions, SneeTechnique, SneeTransport};
 use super::stats::LocalStats;
 use super::volpath;
@@ -69,7 +71,22 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
     Ok(SneeOptions { technique, transport, rate })
 }
 
-/// SNEE's tables for `scene` (per-medium rates, emitter mixture), built once at scene load.
-pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
-    snee::rate::build(scene, options)
+/// The `connection` parameter (manifold NEE, `integrator/manifold/`).
+pub fn parse_connection(props: &Props) -> Result<Connection> {
+    match props.string("connection", "paper")?.as_str() {
+        "paper" => Ok(Connection::Paper),
+        "complete" => Ok(Connection::Complete),
+        other => Err(props
+            .error("connection", format!("volpath_snee: connection = \"{}\" is not one of paper, complete", other))),
+    }
+}
+
+/// SNEE's tables for `scene` (per-medium rates, emitter mixture), and with `connection =
+/// complete` the manifold connection's flat boundaries, built once at scene load.
+pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Snee {
+    let mut snee = snee::rate::build(scene, options);
+    if connection == Connection::Complete {
+        snee.flat = manifold::flat::flat_boundaries(scene);
+    }
+    snee
 }

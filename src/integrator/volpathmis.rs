@@ -43,6 +43,7 @@
 //! volpathmis loses ~40 % of the red channel on our test scene (σt,blue = 1e-30 gives the limit)
 //! and its volpath returns NaN; we do not reproduce that.
 
+use super::manifold::ManifoldStage;
 use super::snee::SneeStage;
 use super::stats::LocalStats;
 use super::volpath::{trace, Cx, EmitterHit, PathWeight};
@@ -302,6 +303,7 @@ impl PathWeight for SpectralMis {
         _ray_d: Vec3,
         count_direct: bool,
         _snee: Option<&SneeStage>,
+        _manifold: Option<&ManifoldStage>,
     ) -> Spectrum {
         let scene = cx.scene;
 

@@ -55,4 +55,7 @@ pub struct Snee {
     /// Does the scene have a non-delta emitter (area, envmap, constant, ...)? Decides the mixture
     /// of ↓ and ↑ at a smooth boundary (docs/snee.md §2.5).
     pub has_non_delta_emitter: bool,
+    /// Per medium: its flat smooth boundary where the manifold connection applies
+    /// (`connection = complete`, `manifold::flat::flat_boundaries`; empty with `paper`).
+    pub flat: Vec<Option<crate::integrator::manifold::flat::FlatBoundary>>,
 }

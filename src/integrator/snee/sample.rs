@@ -12,6 +12,7 @@ use super::{encloses, with_wi, Boundary, SneeSuffix, SneeVertex};
 use crate::bsdf::fresnel::{fresnel, refract};
 use crate::bsdf::{flags, BsdfContext, TransportMode};
 use crate::color::Spectrum;
+use crate::integrator::manifold;
 use crate::integrator::stats::LocalStats;
 use crate::interaction::offset_origin;
 use crate::math::{warp, Ray, Vec2};
@@ -186,6 +187,9 @@ fn sample_impl(
     if !(pdfs.snee > 0.0) {
         return Spectrum::ZERO;
     }
-    let w = suffix_weights(snee.options.technique, pdfs).snee;
+    let technique = snee.options.technique;
+    let w = suffix_weights(technique, pdfs).snee;
+    // With `connection = complete`, the manifold connection shares this suffix (docs/manifold.md §4).
+    let w = manifold::snee_weight(scene, technique, &suffix, &light, channel, pdfs.snee).unwrap_or(w);
     f * (w / pdfs.snee) as f32
 }

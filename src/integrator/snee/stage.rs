@@ -77,6 +77,24 @@ impl<'a> SneeStage<'a> {
         }
     }
 
+    /// `x_i` of the chain `x_i → x_j` ending at the current scatter, if `x_i` was a SNEE vertex.
+    #[inline]
+    pub fn chain_x_i(&self) -> Option<&SneeVertex> {
+        self.chain.as_ref().map(|c| &c.0)
+    }
+
+    /// The suffix the ray carried when it reached the current surface (after refraction at `x_k`).
+    #[inline]
+    pub fn arrived(&self) -> Option<&SneeSuffix> {
+        self.arrived.as_ref()
+    }
+
+    /// The tables SNEE was built with (`volpath_snee`'s).
+    #[inline]
+    pub fn tables(&self) -> &'a Snee {
+        self.snee
+    }
+
     /// The ray along `d` reached a surface (`None`: it escaped). A surface event ends SNEE chains;
     /// it is `x_k` when it follows `x_i → x_j` on a boundary enclosing `x_i`'s medium.
     #[inline]

@@ -1,0 +1,156 @@
+//! MIS of the manifold connection to an ENVIRONMENT (envmap, constant) with the other techniques
+//! that make the same suffix `x_j → x_k → environment` (docs/manifold.md §4.2):
+//! forward tracing (phase sampling at `x_j`, free flight surviving to `x_k`, the refraction chosen
+//! with probability `1 − F`, escape), and SNEE at `x_i` when `x_i → x_j → x_k` is in its support.
+//! All three densities are taken in the solid angle of `omega_jk` at `x_j` (conditioned on `x_j`):
+//!
+//! | technique | density |
+//! |---|---|
+//! | manifold | `p_env(omega_l) · dω_l/dω_in = p_env · η² cos θ_in / cos θ_l` |
+//! | forward  | `f_p(wi_j, omega_jk) · e^{−σ_t d_jk} · (1 − F)` |
+//! | SNEE     | `pdf_snee / (p_V(x_j | x_i) · cos θ_k / d_jk²)` (its `dV(x_j) dA(x_k)` density over forward's density of `x_j`, and `dA(x_k) = d_jk²/cos θ_k dω_jk`) |
+
+use super::flat::{Plane, Refraction};
+use super::pdf;
+use super::MediumVertex;
+use crate::integrator::snee::{self, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeTransport, SneeVertex};
+use crate::integrator::stats::LocalStats;
+use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
+use crate::math::Vec3;
+use crate::scene::world::Scene;
+
+/// The three densities of one environment suffix (solid angle of `omega_jk` at `x_j`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EnvPdfs {
+    pub manifold: f64,
+    pub forward: f64,
+    /// 0 outside SNEE's support.
+    pub snee: f64,
+}
+
+/// The light record of an environment direction seen from `x_k` (SNEE's convention).
+pub fn env_light(scene: &Scene, si_k: &SurfaceInteraction, omega_l: Vec3) -> Option<LightSample> {
+    let env = scene.environment?;
+    let ds = scene.environment_direction_sample(env, omega_l);
+    Some(LightSample {
+        omega_l,
+        p: si_k.p,
+        dist: f32::INFINITY,
+        p_light: scene.pdf_emitter_direction(si_k.p, &ds),
+        delta: false,
+        le: crate::color::Spectrum::ZERO,
+    })
+}
+
+/// Forward density of `x_j` from `x_i` in volume measure (phase sampling, free flight in `channel`).
+fn p_volume(scene: &Scene, x_i: &SneeVertex, x_j: Vec3, channel: usize) -> f64 {
+    let m = &scene.media[x_i.medium as usize];
+    let v = x_j - x_i.p;
+    let t = v.length();
+    pdf::manifold_density(1.0, m.phase.eval(x_i.wi, v / t), m.sigma_t[channel], t, 1.0)
+}
+
+/// The densities of `x_j → x_k → environment` (plus `x_i` before, when given). `check_support`:
+/// test that `x_k` is visible from `x_i` (SNEE's probe); the caller passes `false` when it knows.
+#[allow(clippy::too_many_arguments)]
+pub fn env_pdfs(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    si_k: &SurfaceInteraction,
+    plane: &Plane,
+    r: &Refraction,
+    light: &LightSample,
+    channel: usize,
+    check_support: bool,
+    stats: &mut LocalStats,
+) -> EnvPdfs {
+    let m = &scene.media[x_j.medium as usize];
+    let v = si_k.p - x_j.p;
+    let d_jk = v.length();
+    let omega_jk = v / d_jk;
+    let st = m.sigma_t[channel] as f64;
+    let eta2 = (plane.eta as f64) * (plane.eta as f64);
+    let manifold = light.p_light as f64 * eta2 * r.cos_in as f64 / r.cos_l as f64;
+    let forward = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp() * (1.0 - r.fresnel as f64);
+    let mut snee = 0.0;
+    if let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) {
+        let visible = !check_support || {
+            stats.rays += 1;
+            let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
+            !scene.ray_test(&spawn_ray_between(x_i.p, inner_k))
+        };
+        if let (true, Some(tables)) = (visible, super::tables(scene)) {
+            let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
+            let pdf_snee = snee::pdf_snee(scene, tables, &suffix, light, channel);
+            let to_sa = p_volume(scene, x_i, x_j.p, channel) * r.cos_in as f64 / (d_jk as f64 * d_jk as f64);
+            if to_sa > 0.0 {
+                snee = pdf_snee / to_sa;
+            }
+        }
+    }
+    let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
+    EnvPdfs { manifold: finite(manifold), forward: finite(forward), snee: finite(snee) }
+}
+
+/// Which technique made the suffix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvTechnique {
+    Manifold,
+    Forward,
+    Snee,
+}
+
+/// Weight of `technique` for a suffix with densities `p`: the power heuristic over the three
+/// (`snee = mis`); `snee = snee`: SNEE takes what it can make, the other two share the rest;
+/// `snee = forward`: SNEE's density is 0. `transport = snee`: suffixes outside SNEE's support get 0.
+pub fn env_weight(opts: SneeOptions, technique: EnvTechnique, p: EnvPdfs) -> f64 {
+    let s = if opts.technique == SneeTechnique::Forward { 0.0 } else { p.snee };
+    if opts.transport == SneeTransport::Snee && s == 0.0 {
+        return 0.0;
+    }
+    if opts.technique == SneeTechnique::Snee && s > 0.0 {
+        return if technique == EnvTechnique::Snee { 1.0 } else { 0.0 };
+    }
+    let own = match technique {
+        EnvTechnique::Manifold => p.manifold,
+        EnvTechnique::Forward => p.forward,
+        EnvTechnique::Snee => s,
+    };
+    if !(own > 0.0) {
+        return 0.0;
+    }
+    // Ratios against the own density avoid overflow of the squares.
+    let (a, b, c) = (p.manifold / own, p.forward / own, s / own);
+    let w = 1.0 / (a * a + b * b + c * c);
+    if w.is_finite() {
+        w
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn env_weights_partition_unity() {
+        for technique in [SneeTechnique::Mis, SneeTechnique::Snee, SneeTechnique::Forward] {
+            let opts = SneeOptions { technique, ..SneeOptions::default() };
+            for p in [
+                EnvPdfs { manifold: 1.0, forward: 2.0, snee: 3.0 },
+                EnvPdfs { manifold: 1e-20, forward: 5.0, snee: 0.0 },
+                EnvPdfs { manifold: 4.0, forward: 0.0, snee: 1e10 },
+            ] {
+                let sum: f64 = [EnvTechnique::Manifold, EnvTechnique::Forward, EnvTechnique::Snee]
+                    .iter()
+                    .filter(|t| **t != EnvTechnique::Snee || technique != SneeTechnique::Forward)
+                    .map(|t| env_weight(opts, *t, p))
+                    .sum();
+                assert!((sum - 1.0).abs() < 1e-12, "{technique:?} {p:?}: {sum}");
+            }
+        }
+    }
+}

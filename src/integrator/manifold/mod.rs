@@ -1,0 +1,396 @@
+//! Manifold next-event estimation through a flat smooth boundary (`volpath_snee`,
+//! `connection = complete`): from every real scattering vertex inside a medium enclosed by a
+//! smooth `dielectric`, connect to a directional light or an environment through the refraction
+//! at the boundary. Derivation, densities and what is left out: `docs/manifold.md`.
+//!
+//! | Parameter    | Type   | Description                                                              |
+//! |--------------|--------|--------------------------------------------------------------------------|
+//! | `connection` | string | `paper` (default): the paper's `volpath_snee` (SNEE + forward tracing); `complete`: also the manifold connection at every medium vertex, combined with SNEE by MIS |
+//!
+//! ```xml
+//! <integrator type="volpath_snee">
+//!     <string name="connection" value="complete"/>
+//! </integrator>
+//! ```
+//!
+//! Inside a refractive boundary the ordinary NEE shadow ray is always blocked and returns 0; this
+//! technique takes its place. Under a directional light it makes suffixes no forward technique can
+//! make (a delta light behind a delta interface) and shares V–V–S_t–L suffixes with SNEE; under an
+//! environment it also shares them with forward tracing ([`mis`]). Scope (docs/manifold.md §6):
+//! directional lights and environments, boundaries made of flat facets ([`flat`]); elsewhere it
+//! draws no samples and `volpath_snee` is the paper's estimator.
+//!
+//! The interface the volpath loop uses: a [`ManifoldStage`] per path next to SNEE's
+//! (`stage.rs`: [`sample`] at a medium vertex, the [`Tracker`] at surfaces, [`forward_weight`] for
+//! an escaping forward path), and [`snee_weight`] for SNEE's side of the MIS (one call in
+//! `snee/sample.rs`). The flat boundaries are built at scene load into `volpath_snee`'s tables
+//! ([`Snee::flat`], read through [`tables`]).
+
+pub mod flat;
+pub mod mis;
+pub mod pdf;
+pub mod stage;
+pub mod track;
+
+use super::desc::Integrator;
+use super::snee::{self, LightSample, Snee, SneeOptions, SneeSuffix, SneeTechnique, SneeTransport, SneeVertex};
+use super::stats::LocalStats;
+use crate::color::Spectrum;
+use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
+use crate::math::{Ray, Vec2, Vec3};
+use crate::sampler::Sampler;
+use crate::scene::world::Scene;
+use flat::{on_plane, refract_into, FlatBoundary, Plane, Refraction};
+pub use stage::ManifoldStage;
+pub use track::Tracker;
+
+/// Which estimator `volpath_snee` runs (`connection` parameter).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Connection {
+    /// The paper's: SNEE and forward tracing only.
+    #[default]
+    Paper,
+    /// Also the manifold connection at every medium vertex (where it applies), MIS with SNEE.
+    Complete,
+}
+
+impl Connection {
+    pub fn name(self) -> &'static str {
+        match self {
+            Connection::Paper => "paper",
+            Connection::Complete => "complete",
+        }
+    }
+}
+
+/// A medium vertex the connection starts from (`x_j` in docs/manifold.md).
+#[derive(Clone, Copy, Debug)]
+pub struct MediumVertex {
+    pub p: Vec3,
+    /// Direction back to the previous vertex (the phase function's `wi`).
+    pub wi: Vec3,
+    pub medium: u32,
+}
+
+/// The deterministic part of a connection: the boundary point and the refraction there.
+#[derive(Clone, Copy, Debug)]
+pub struct ManifoldSuffix {
+    pub si_k: SurfaceInteraction,
+    pub refraction: Refraction,
+    pub plane: Plane,
+    /// Distance `x_j → x_k`.
+    pub d_jk: f32,
+}
+
+/// One solution of the connection: its contribution `f / p_sel` without the path throughput and
+/// without MIS weight (the caller's business), and the suffix for the weight.
+#[derive(Clone, Copy, Debug)]
+pub struct ManifoldConnection {
+    pub value: Spectrum,
+    pub suffix: ManifoldSuffix,
+}
+
+/// Does the manifold connection run at all in this render?
+#[inline]
+pub fn enabled(scene: &Scene) -> bool {
+    scene.integrator.connection == Connection::Complete
+}
+
+/// `volpath_snee`'s tables as built at scene load (SNEE's, with the flat boundaries in
+/// [`Snee::flat`]), when that is the scene's integrator.
+#[inline]
+pub fn tables(scene: &Scene) -> Option<&Snee> {
+    match &scene.integrator {
+        Integrator::VolpathSnee(_, snee) => Some(snee),
+        _ => None,
+    }
+}
+
+/// The flat boundary of `medium` where the connection applies (built with `connection = complete`).
+#[inline]
+pub fn boundary_of(scene: &Scene, medium: u32) -> Option<&FlatBoundary> {
+    tables(scene)?.flat.get(medium as usize)?.as_ref()
+}
+
+/// Upper bound on the interfaces crossed by one light segment.
+const MAX_LIGHT_SEGMENTS: u32 = 64;
+
+/// Transmission of the light segment from `x_k` along `omega_l` to infinity through passable
+/// surfaces (`snee::passable`: the same definition as SNEE's, so both techniques have the same
+/// support); zero when anything else blocks it.
+fn light_segment(scene: &Scene, si_k: &SurfaceInteraction, omega_l: Vec3, stats: &mut LocalStats) -> Spectrum {
+    let mut ray = Ray::new(offset_origin(si_k.p, si_k.n, omega_l), omega_l);
+    let mut tr = Spectrum::ONE;
+    for _ in 0..MAX_LIGHT_SEGMENTS {
+        stats.rays += 1;
+        let Some(hit) = scene.ray_intersect(&ray) else { return tr };
+        if !snee::passable(scene, &hit) {
+            return Spectrum::ZERO;
+        }
+        tr *= scene.bsdf(&hit).eval_null_transmission(&hit);
+        ray = Ray::new(offset_origin(hit.p, hit.n, omega_l), omega_l);
+    }
+    Spectrum::ZERO
+}
+
+/// Solve the connection from `x_j` through `plane` to a light in the fixed direction `omega_l`
+/// (unit, towards the light: a directional light with `weight = E / p_sel`, or a sampled
+/// environment direction with `weight = L / p_env`): refract, trace back from `x_j` along
+/// `−omega_in`, verify the first hit lies on that plane of the enclosing boundary, and the light
+/// segment. The value is the same for both (docs/manifold.md §3). Counts solutions and failures.
+pub fn connect(
+    scene: &Scene,
+    x_j: &MediumVertex,
+    plane: &Plane,
+    omega_l: Vec3,
+    weight: Spectrum,
+    stats: &mut LocalStats,
+) -> Option<ManifoldConnection> {
+    let refraction = refract_into(plane, omega_l)?;
+    let d = -refraction.omega_in;
+    stats.rays += 1;
+    let hit = scene.ray_intersect(&Ray::new(x_j.p, d));
+    let si_k = match hit {
+        Some(si) if on_plane(scene, &si, x_j.medium, d, plane) => si,
+        _ => {
+            stats.manifold_failures += 1;
+            return None;
+        }
+    };
+    let tr_out = light_segment(scene, &si_k, omega_l, stats);
+    if tr_out == Spectrum::ZERO {
+        stats.manifold_failures += 1;
+        return None;
+    }
+    stats.manifold_solutions += 1;
+    let m = &scene.media[x_j.medium as usize];
+    let d_jk = si_k.t;
+    let value = m.phase.eval(x_j.wi, d)
+        * m.transmittance(d_jk)
+        * pdf::beam_factor(refraction.fresnel, refraction.cos_l, refraction.cos_in)
+        * tr_out
+        * weight;
+    Some(ManifoldConnection { value, suffix: ManifoldSuffix { si_k, refraction, plane: *plane, d_jk } })
+}
+
+/// The manifold stage at a real scatter `x_j` (depth `depth`, throughput `beta` including
+/// `sigma_s`): one emitter sample, every plane's solution, each MIS-weighted against SNEE run at
+/// the previous vertex `x_i` (when that was a SNEE vertex and no surface event came between) and,
+/// for an environment, against forward tracing. `None` when the connection does not run here
+/// (then its density is 0 for suffixes from `x_j`); it draws one 2-D sample whenever it runs.
+#[allow(clippy::too_many_arguments)]
+pub fn sample(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: MediumVertex,
+    beta: Spectrum,
+    depth: u32,
+    max_depth: u32,
+    channel: usize,
+    sampler: &mut Sampler,
+    stats: &mut LocalStats,
+) -> Option<Spectrum> {
+    if !enabled(scene) {
+        return None;
+    }
+    let boundary = boundary_of(scene, x_j.medium)?;
+    let u: Vec2 = sampler.next_2d();
+    // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).
+    if depth.saturating_add(1) >= max_depth {
+        return None;
+    }
+    stats.manifold_attempts += 1;
+    let (ds, weight) = scene.sample_emitter_direction(x_j.p, None, u, false);
+    // Directional lights (delta, infinitely far) and environments (non-delta, infinitely far).
+    if !(ds.pdf > 0.0) || ds.dist.is_finite() || weight == Spectrum::ZERO {
+        return Some(Spectrum::ZERO);
+    }
+    let environment = !ds.delta;
+    if environment && scene.environment != Some(ds.emitter) {
+        return Some(Spectrum::ZERO);
+    }
+    let mut result = Spectrum::ZERO;
+    for plane in &boundary.planes {
+        let Some(c) = connect(scene, &x_j, plane, ds.d, weight, stats) else { continue };
+        let w = if environment {
+            let Some(light) = mis::env_light(scene, &c.suffix.si_k, ds.d) else { continue };
+            let p = mis::env_pdfs(
+                scene,
+                opts,
+                x_i,
+                &x_j,
+                &c.suffix.si_k,
+                plane,
+                &c.suffix.refraction,
+                &light,
+                channel,
+                true,
+                stats,
+            );
+            mis::env_weight(opts, mis::EnvTechnique::Manifold, p)
+        } else {
+            let light =
+                LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: true, le: Spectrum::ZERO };
+            weight_against_snee(scene, opts, x_i, &x_j, &c.suffix, &light, channel, stats)
+        };
+        let contribution = beta * c.value * w as f32;
+        if crate::color::is_finite(contribution) {
+            result += contribution;
+        } else {
+            stats.rejected_samples += 1;
+        }
+    }
+    Some(result)
+}
+
+impl Tracker {
+    /// [`sample`], remembering `x_j` when the connection ran there (for forward paths' weights).
+    #[allow(clippy::too_many_arguments)]
+    pub fn sample(
+        &mut self,
+        scene: &Scene,
+        opts: SneeOptions,
+        x_i: Option<&SneeVertex>,
+        x_j: MediumVertex,
+        beta: Spectrum,
+        depth: u32,
+        max_depth: u32,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        let r = sample(scene, opts, x_i, x_j, beta, depth, max_depth, channel, sampler, stats);
+        self.x_j = r.map(|_| x_j);
+        r.unwrap_or(Spectrum::ZERO)
+    }
+}
+
+/// The weight of a forward path that escaped to the environment along `omega_l` right after
+/// leaving `x_j`'s medium through a flat plane (`pending`), against the manifold connection and
+/// SNEE (docs/manifold.md §4.2); `None` where the manifold connection cannot make the path (the
+/// caller's weight stands). `snee_pending`: SNEE's record of the same path, when `x_i` was a
+/// SNEE vertex.
+#[allow(clippy::too_many_arguments)]
+pub fn forward_weight(
+    scene: &Scene,
+    opts: Option<SneeOptions>,
+    pending: Option<&track::Pending>,
+    snee_pending: Option<&SneeSuffix>,
+    escaped: bool,
+    omega_l: Vec3,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<f32> {
+    let (opts, pending) = (opts?, pending?);
+    if !escaped || !enabled(scene) {
+        return None;
+    }
+    let light = mis::env_light(scene, &pending.si_k, omega_l)?;
+    let r = refract_into(&pending.plane, omega_l)?;
+    let x_i = snee_pending.filter(|s| s.x_j == pending.x_j.p).map(|s| &s.x_i);
+    let p =
+        mis::env_pdfs(scene, opts, x_i, &pending.x_j, &pending.si_k, &pending.plane, &r, &light, channel, true, stats);
+    Some(mis::env_weight(opts, mis::EnvTechnique::Forward, p) as f32)
+}
+
+/// The manifold connection's MIS weight for a suffix it made at `x_j` (docs/manifold.md §4).
+#[allow(clippy::too_many_arguments)]
+fn weight_against_snee(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    s: &ManifoldSuffix,
+    light: &LightSample,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> f64 {
+    let p_snee = x_i.map_or(0.0, |x_i| snee_density(scene, opts, x_i, x_j, s, light, channel, stats));
+    if p_snee == 0.0 {
+        // Outside SNEE's support: the manifold connection is the only technique.
+        return if opts.transport == SneeTransport::All { 1.0 } else { 0.0 };
+    }
+    let x_i = x_i.expect("p_snee > 0 needs x_i");
+    let m = &scene.media[x_j.medium as usize];
+    let v_ij = x_j.p - x_i.p;
+    let t_ij = v_ij.length();
+    let p_man = pdf::manifold_density(
+        light.p_light,
+        m.phase.eval(x_i.wi, v_ij / t_ij),
+        m.sigma_t[channel],
+        t_ij,
+        s.refraction.cos_in,
+    );
+    pdf::manifold_weight(opts.technique, p_man, p_snee)
+}
+
+/// SNEE's density (measure `dt dA(x_k)`) of the suffix `x_i → x_j → x_k → light`, 0 outside its
+/// support: SNEE ran at `x_i` (not `snee = forward`), `x_k` is visible from `x_i` (the probe's
+/// first hit), and `x_i → x_j` is clear (it is: forward sampled it inside the medium).
+#[allow(clippy::too_many_arguments)]
+fn snee_density(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: &SneeVertex,
+    x_j: &MediumVertex,
+    s: &ManifoldSuffix,
+    light: &LightSample,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> f64 {
+    if opts.technique == SneeTechnique::Forward || x_i.medium != x_j.medium {
+        return 0.0;
+    }
+    let inner_k = offset_origin(s.si_k.p, s.si_k.n, x_i.p - s.si_k.p);
+    stats.rays += 1;
+    if scene.ray_test(&spawn_ray_between(x_i.p, inner_k)) {
+        return 0.0;
+    }
+    let Some(tables) = tables(scene) else { return 0.0 };
+    let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: s.si_k };
+    let pdf_snee = snee::pdf_snee(scene, tables, &suffix, light, channel);
+    let ratio = pdf::solid_angle_ratio(s.refraction.cos_l, s.refraction.cos_in, s.plane.eta);
+    pdf::snee_density(pdf_snee, s.d_jk, ratio)
+}
+
+/// SNEE's full MIS weight for a suffix SNEE made that the manifold connection can also make, or
+/// `None` (SNEE's own weight stands). Directional light: only SNEE and the manifold connection
+/// make it (forward tracing cannot), two-way power heuristic in `dt dA(x_k)`; environment: the
+/// three-way weight of [`mis::env_weight`].
+pub fn snee_weight(
+    scene: &Scene,
+    technique: SneeTechnique,
+    s: &SneeSuffix,
+    light: &LightSample,
+    channel: usize,
+    pdf_snee: f64,
+) -> Option<f64> {
+    if !enabled(scene) || light.dist.is_finite() {
+        return None;
+    }
+    let boundary = boundary_of(scene, s.x_i.medium)?;
+    let si_k = &s.si_k;
+    let crate::bsdf::Bsdf::Dielectric(d) = scene.bsdf(si_k) else { return None };
+    let plane = boundary.planes.iter().find(|p| si_k.n.dot(p.n) > flat::SAME_NORMAL && d.eta == p.eta)?;
+    let r = refract_into(plane, light.omega_l)?;
+    let m = &scene.media[s.x_i.medium as usize];
+    let v_ij = s.x_j - s.x_i.p;
+    let t_ij = v_ij.length();
+    if !light.delta {
+        scene.environment?;
+        let opts = SneeOptions { technique, ..scene.integrator.snee };
+        let x_j = MediumVertex { p: s.x_j, wi: -v_ij / t_ij, medium: s.x_i.medium };
+        // No support check: no rays traced, nothing to count.
+        let mut no_rays = LocalStats::default();
+        let p = mis::env_pdfs(scene, opts, Some(&s.x_i), &x_j, si_k, plane, &r, light, channel, false, &mut no_rays);
+        return Some(mis::env_weight(opts, mis::EnvTechnique::Snee, p));
+    }
+    // The manifold connection runs at x_j if x_j's depth leaves room for x_k: the same condition
+    // as x_i being a SNEE vertex, which it is here.
+    let p_man =
+        pdf::manifold_density(light.p_light, m.phase.eval(s.x_i.wi, v_ij / t_ij), m.sigma_t[channel], t_ij, r.cos_in);
+    let t_kj = (s.x_j - si_k.p).length();
+    let p_snee = pdf::snee_density(pdf_snee, t_kj, pdf::solid_angle_ratio(r.cos_l, r.cos_in, plane.eta));
+    Some(pdf::snee_weight(technique, p_snee, p_man))
+}

@@ -1,0 +1,100 @@
+//! Manifold NEE as one stage of the volpath loop, next to SNEE's (`snee::stage`): its per-path
+//! state and the places where the loop asks it something (`volpath_snee`, `connection = complete`
+//! only; with `paper` the loop has no such stage). The loop owns the path; this type never edits it.
+//!
+//! | loop event                   | call                          | what the manifold connection does                |
+//! |------------------------------|-------------------------------|--------------------------------------------------|
+//! | real scatter `p` in a medium | [`ManifoldStage::at_scatter`] | `x_j = p`; one connection through the flat boundary, MIS-weighted against SNEE run at the previous vertex `x_i` (`manifold::sample`) |
+//! | the ray reaches a surface    | [`ManifoldStage::at_surface`] | takes the pending suffix `x_j → x_k → …` the ray carries ([`Tracker::surface_event`]) |
+//! | an emitter is hit            | [`ManifoldStage::weight`]     | the MIS weight of an escape right after leaving `x_j`'s medium (`manifold::forward_weight`) |
+//! | BSDF sampling at a surface   | [`ManifoldStage::after_bsdf`] | starts or carries the pending suffix ([`Tracker::after_bsdf`]) |
+//!
+//! SNEE's side of the MIS (a SNEE sample the connection could also have made) is one call in
+//! `snee/sample.rs` (`manifold::snee_weight`).
+
+use super::track::{Pending, Tracker};
+use super::{forward_weight, Connection, MediumVertex};
+use crate::bsdf::BsdfSample;
+use crate::color::Spectrum;
+use crate::integrator::snee::{Snee, SneeStage};
+use crate::integrator::stats::LocalStats;
+use crate::interaction::SurfaceInteraction;
+use crate::math::Vec3;
+use crate::sampler::Sampler;
+use crate::scene::world::Scene;
+
+/// The manifold connection's state along one path.
+#[derive(Clone, Debug)]
+pub struct ManifoldStage<'a> {
+    snee: &'a Snee,
+    /// The last medium vertex `x_j` and the suffix the ray leaving the last surface carries.
+    tracker: Tracker,
+    /// The pending suffix as it was when the ray reached the current surface (or escaped).
+    arrived: Option<Pending>,
+    /// Did the current ray escape the scene (an environment hit)?
+    escaped: bool,
+}
+
+impl<'a> ManifoldStage<'a> {
+    /// The stage for a `volpath_snee` path, `None` unless `connection = complete`.
+    pub fn new(scene: &Scene, snee: &'a Snee) -> Option<Self> {
+        (scene.integrator.connection == Connection::Complete).then(|| ManifoldStage {
+            snee,
+            tracker: Tracker::default(),
+            arrived: None,
+            escaped: false,
+        })
+    }
+
+    /// At a real scatter `x_j = p` (depth `depth`) in `medium`, after SNEE's stage ran there (its
+    /// chain gives `x_i`): one connection. Returns its contribution (`beta`: the throughput at
+    /// `p` including `sigma_s`).
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn at_scatter(
+        &mut self,
+        scene: &Scene,
+        snee: &SneeStage,
+        medium: u32,
+        p: Vec3,
+        wi: Vec3,
+        depth: u32,
+        max_depth: u32,
+        beta: Spectrum,
+        channel: usize,
+        sampler: &mut Sampler,
+        stats: &mut LocalStats,
+    ) -> Spectrum {
+        let x_j = MediumVertex { p, wi, medium };
+        let opts = self.snee.options;
+        self.tracker.sample(scene, opts, snee.chain_x_i(), x_j, beta, depth, max_depth, channel, sampler, stats)
+    }
+
+    /// The ray reached a surface (`None`: it escaped).
+    #[inline]
+    pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
+        self.arrived = self.tracker.surface_event();
+        self.escaped = si.is_none();
+    }
+
+    /// The weight of an emitter hit along `d` by forward tracing, when the manifold connection
+    /// shares the path; `None`: the caller's weight stands.
+    #[inline]
+    pub fn weight(
+        &self,
+        scene: &Scene,
+        snee: &SneeStage,
+        d: Vec3,
+        channel: usize,
+        stats: &mut LocalStats,
+    ) -> Option<f32> {
+        let opts = Some(self.snee.options);
+        forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.escaped, d, channel, stats)
+    }
+
+    /// BSDF sampling at `s` chose `bs` towards `wo`.
+    #[inline]
+    pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
+        self.tracker.after_bsdf(scene, s, bs.sampled_type, wo, self.arrived.take());
+    }
+}
