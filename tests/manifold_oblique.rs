@@ -22,28 +22,13 @@ use std::sync::atomic::AtomicBool;
 const THETA0_DEG: f64 = 50.0;
 
 fn slab(n: f64, albedo: f64, g: f64) -> String {
+    assert!(g != 0.0, "the hg phase is what this test integrates");
     let (s, c) = THETA0_DEG.to_radians().sin_cos();
-    format!(
-        r#"<scene version="3.0.0">
-    <integrator type="volpath_snee"><integer name="max_depth" value="4"/><string name="connection" value="complete"/></integrator>
-    <emitter type="directional"><vector name="direction" value="{s}, 0, {mc}"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
-    <medium type="homogeneous" id="slab"><float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>
-        <phase type="hg"><float name="g" value="{g}"/></phase></medium>
-    <shape type="cube">
-        <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
-        <bsdf type="dielectric"><float name="int_ior" value="{n}"/><float name="ext_ior" value="1"/></bsdf>
-        <ref name="interior" id="slab"/>
-    </shape>
-    <shape type="rectangle">
-        <transform name="to_world"><scale value="5"/><rotate x="1" angle="180"/><translate z="0.01"/></transform>
-        <bsdf type="null"/>
-        <sensor type="irradiancemeter">
-            <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
-        </sensor>
-    </shape>
-</scene>"#,
-        mc = -c
-    )
+    let integrator = r#"<integrator type="volpath_snee"><integer name="max_depth" value="4"/><string name="connection" value="complete"/></integrator>"#;
+    let boundary = format!(
+        r#"<bsdf type="dielectric"><float name="int_ior" value="{n}"/><float name="ext_ior" value="1"/></bsdf>"#
+    );
+    common::slab_scene(integrator, &format!("{s}, 0, {}", -c), albedo, g, &boundary)
 }
 
 /// Unpolarized Fresnel reflectance for a ray with |cos| = `cos_i` on the side of index `n_i`.

@@ -22,31 +22,14 @@ use snee::render::{render, RenderOptions};
 use std::sync::atomic::AtomicBool;
 
 fn slab(connection: &str, technique: &str, n: f64, albedo: f64, g: f64) -> String {
-    let phase = if g == 0.0 {
-        r#"<phase type="isotropic"/>"#.to_string()
-    } else {
-        format!(r#"<phase type="hg"><float name="g" value="{g}"/></phase>"#)
-    };
-    format!(
-        r#"<scene version="3.0.0">
-    <integrator type="volpath_snee"><integer name="max_depth" value="-1"/>
-        <string name="connection" value="{connection}"/><string name="snee" value="{technique}"/></integrator>
-    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
-    <medium type="homogeneous" id="slab"><float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>{phase}</medium>
-    <shape type="cube">
-        <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
-        <bsdf type="dielectric"><float name="int_ior" value="{n}"/><float name="ext_ior" value="1"/></bsdf>
-        <ref name="interior" id="slab"/>
-    </shape>
-    <shape type="rectangle">
-        <transform name="to_world"><scale value="5"/><rotate x="1" angle="180"/><translate z="0.01"/></transform>
-        <bsdf type="null"/>
-        <sensor type="irradiancemeter">
-            <film type="hdrfilm"><integer name="width" value="1"/><integer name="height" value="1"/><rfilter type="box"/></film>
-        </sensor>
-    </shape>
-</scene>"#
-    )
+    let integrator = format!(
+        r#"<integrator type="volpath_snee"><integer name="max_depth" value="-1"/>
+        <string name="connection" value="{connection}"/><string name="snee" value="{technique}"/></integrator>"#
+    );
+    let boundary = format!(
+        r#"<bsdf type="dielectric"><float name="int_ior" value="{n}"/><float name="ext_ior" value="1"/></bsdf>"#
+    );
+    common::slab_scene(&integrator, "0, 0, -1", albedo, g, &boundary)
 }
 
 /// Reading of the meter over `batches` independent renders: (mean, standard error, rejected

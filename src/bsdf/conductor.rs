@@ -146,8 +146,8 @@ impl Conductor {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bsdf::test_util::si_with_wi;
     use crate::math::Vec3;
+    use crate::testing::si_with_wi;
 
     #[test]
     fn mirror_reflection_with_fresnel() {

@@ -116,9 +116,9 @@ impl Dielectric {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_util::si_with_wi;
     use super::*;
     use crate::math::Vec3;
+    use crate::testing::si_with_wi;
 
     #[test]
     fn directions_and_weights() {

@@ -371,24 +371,3 @@ pub(crate) fn eval_1(tex: &Texture, uv: Vec2) -> f32 {
         t => crate::color::luminance(t.eval(uv)),
     }
 }
-
-#[cfg(test)]
-pub(crate) mod test_util {
-    //! Helpers for the BSDF unit tests.
-    use crate::interaction::SurfaceInteraction;
-    use crate::math::{Frame, Vec2, Vec3};
-
-    /// A hit at the origin with normal +Z and the given local `wi`.
-    pub fn si_with_wi(wi: Vec3) -> SurfaceInteraction {
-        SurfaceInteraction {
-            t: 1.0,
-            p: Vec3::ZERO,
-            n: Vec3::Z,
-            sh_frame: Frame::from_normal(Vec3::Z),
-            uv: Vec2::splat(0.5),
-            wi,
-            shape: 0,
-            prim: 0,
-        }
-    }
-}

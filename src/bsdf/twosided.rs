@@ -119,9 +119,9 @@ pub(super) fn eval_pdf(
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_util::si_with_wi;
     use super::super::Diffuse;
     use super::*;
+    use crate::testing::si_with_wi;
     use crate::texture::Texture;
 
     fn diffuse(c: Spectrum) -> Bsdf {

@@ -136,6 +136,13 @@ pub fn meter_reading(scene: &Scene, spp: u32, batches: u64, seed0: u64) -> (f64,
 /// z = 0, bounded by the BSDF `boundary` (XML), under a directional beam travelling along −z, read
 /// by an `irradiancemeter` on a 10×10 `null` quad facing down just above it.
 pub fn slab_xml(integrator: &str, albedo: f64, g: f64, boundary: &str) -> String {
+    let integrator = format!(r#"<integrator type="{integrator}"><integer name="max_depth" value="-1"/></integrator>"#);
+    slab_scene(&integrator, "0, 0, -1", albedo, g, boundary)
+}
+
+/// The slab of [`slab_xml`] with the whole `<integrator>` element given and the beam travelling
+/// along `direction` (XML vector text).
+pub fn slab_scene(integrator: &str, direction: &str, albedo: f64, g: f64, boundary: &str) -> String {
     let phase = if g == 0.0 {
         r#"<phase type="isotropic"/>"#.to_string()
     } else {
@@ -143,8 +150,8 @@ pub fn slab_xml(integrator: &str, albedo: f64, g: f64, boundary: &str) -> String
     };
     format!(
         r#"<scene version="3.0.0">
-    <integrator type="{integrator}"><integer name="max_depth" value="-1"/></integrator>
-    <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
+    {integrator}
+    <emitter type="directional"><vector name="direction" value="{direction}"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
     <medium type="homogeneous" id="slab"><float name="albedo" value="{albedo}"/><float name="sigma_t" value="1"/>{phase}</medium>
     <shape type="cube">
         <transform name="to_world"><scale x="100" y="100" z="50"/><translate z="-50"/></transform>
