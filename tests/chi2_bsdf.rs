@@ -18,7 +18,7 @@ use snee::scene::desc::{ObjectDesc, PluginKind, Props, Value};
 use snee::scene::resolver::FileResolver;
 use snee::scene::SrcPos;
 use snee::testing::chi2::{chi2_discrete, chi2_sphere, sidak};
-use snee::testing::{si_with_wi, sph};
+use snee::testing::{push_alpha, si_with_wi, sph};
 use std::rc::Rc;
 
 // ---- Construction helpers ----
@@ -46,12 +46,7 @@ fn rough(ggx: bool, alpha_u: f32, alpha_v: f32, int_ior: f32, ext_ior: f32, visi
         ("ext_ior", Value::Float(ext_ior as f64)),
         ("sample_visible", Value::Bool(visible)),
     ];
-    if alpha_u == alpha_v {
-        p.push(("alpha", Value::Float(alpha_u as f64)));
-    } else {
-        p.push(("alpha_u", Value::Float(alpha_u as f64)));
-        p.push(("alpha_v", Value::Float(alpha_v as f64)));
-    }
+    push_alpha(&mut p, alpha_u, alpha_v);
     load("roughdielectric", p)
 }
 

@@ -27,3 +27,15 @@ pub fn sph(theta_deg: f32, phi_deg: f32) -> Vec3 {
     let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
     Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
 }
+
+/// Push a microfacet roughness as Mitsuba's plugins take it: `alpha` when isotropic, else
+/// `alpha_u` and `alpha_v`.
+pub fn push_alpha(props: &mut Vec<(&str, crate::scene::desc::Value)>, alpha_u: f32, alpha_v: f32) {
+    use crate::scene::desc::Value;
+    if alpha_u == alpha_v {
+        props.push(("alpha", Value::Float(alpha_u as f64)));
+    } else {
+        props.push(("alpha_u", Value::Float(alpha_u as f64)));
+        props.push(("alpha_v", Value::Float(alpha_v as f64)));
+    }
+}
