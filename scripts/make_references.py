@@ -86,6 +86,7 @@ DEFAULT_SPP = {
     "surfaces_metals": 8192,
     "surfaces_plastics": 8192,
     "surfaces_translucent": 8192,
+    "surfaces_anisotropic": 8192,
 }
 FALLBACK_SPP = 4096
 MAX_SAMPLES_PER_PASS = 1 << 22

@@ -49,6 +49,22 @@ impl SurfaceInteraction {
     }
 }
 
+/// The shading frame around the unit shading normal `n` with its tangent `s` along the surface's
+/// dp/du (Mitsuba's `SurfaceInteraction::initialize_sh_frame`): Gram–Schmidt, s = normalize(dp_du −
+/// n (n·dp_du)), t = n × s. This orients anisotropic BSDFs (`alpha_u` along `s`). Without a usable
+/// dp/du (zero, as Mitsuba tests, or parallel to `n`) the frame is `Frame::from_normal(n)` (Mitsuba's
+/// `coordinate_system`).
+#[inline]
+pub fn shading_frame(n: Vec3, dp_du: Vec3) -> Frame {
+    let s = dp_du - n * n.dot(dp_du);
+    let len2 = s.length_squared();
+    if !(len2 > 0.0 && len2.is_finite()) {
+        return Frame::from_normal(n);
+    }
+    let s = s / len2.sqrt();
+    Frame { s, t: n.cross(s), n }
+}
+
 /// Offset a surface point along its geometric normal `n`, to the side that `d` points to
 /// (Mitsuba's `offset_p`: scaled with the magnitude of the coordinates).
 #[inline]

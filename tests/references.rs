@@ -383,3 +383,9 @@ fn surfaces_plastics() {
 fn surfaces_translucent() {
     check_scene("surfaces_translucent", 128, true);
 }
+// Anisotropic roughconductor on a rotated uv-mapped mesh, a rotated mesh without uvs, a rotated
+// sphere and a tilted disk: the shading frame's tangent must be Mitsuba's dp/du.
+#[test]
+fn surfaces_anisotropic() {
+    check_scene("surfaces_anisotropic", 32, true);
+}

@@ -245,7 +245,7 @@ impl Builder<'_> {
 
     fn shape(&mut self, obj: &Rc<ObjectDesc>) -> Result<()> {
         let props = &obj.props;
-        let geometry = Geometry::from_desc(obj, self.resolver)?;
+        let mut geometry = Geometry::from_desc(obj, self.resolver)?;
         let index = self.shapes.len() as u32;
         let interior = match props.object_named("interior", PluginKind::Medium)? {
             Some(m) => Some(self.medium(&m)?),
@@ -269,6 +269,10 @@ impl Builder<'_> {
                 ));
             }
             let radiance = crate::emitter::area::from_desc(&e, self.resolver)?;
+            if let Geometry::Sphere(s) = &mut geometry {
+                // Light samples need the sphere's uv (acos, atan2) only for a textured radiance.
+                s.sample_uv = radiance.is_spatially_varying();
+            }
             self.emitters.push(SceneEmitter::Area { shape: index, radiance });
             emitter = Some((self.emitters.len() - 1) as u32);
         }

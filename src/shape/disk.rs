@@ -1,11 +1,13 @@
 //! Mitsuba's analytic `disk`: the unit disk in the local XY plane, normal +Z, placed by `to_world`.
+//! uv = (r, φ / 2π) of the local point; dp/du = to_world (cos φ, sin φ, 0), radial, orients the
+//! shading frame's tangent (anisotropic BSDFs), as in Mitsuba 3.9 (`(1, 0)` at the centre).
 //!
 //! ```xml
 //! <shape type="disk"><transform name="to_world"><scale value="0.3"/></transform></shape>
 //! ```
 
-use crate::interaction::{PositionSample, SurfaceInteraction};
-use crate::math::{warp, Aabb, Frame, Mat4, Ray, Vec2, Vec3, INV_TWO_PI, PI};
+use crate::interaction::{shading_frame, PositionSample, SurfaceInteraction};
+use crate::math::{warp, Aabb, Mat4, Ray, Vec2, Vec3, INV_TWO_PI, PI};
 
 #[derive(Clone, Debug)]
 pub struct Disk {
@@ -67,7 +69,9 @@ impl Disk {
         local.z = 0.0;
         let p = self.to_world.transform_point3(local);
         let n = if self.flip_normals { -self.n } else { self.n };
-        let sh_frame = Frame::from_normal(n);
+        let r = (local.x * local.x + local.y * local.y).sqrt();
+        let (cos_phi, sin_phi) = if r > 0.0 { (local.x / r, local.y / r) } else { (1.0, 0.0) };
+        let sh_frame = shading_frame(n, self.to_world.transform_vector3(Vec3::new(cos_phi, sin_phi, 0.0)));
         SurfaceInteraction {
             t,
             p,

@@ -3,10 +3,17 @@
 //!
 //! Without vertex normals in the file (and with `face_normals = false`), vertex normals are
 //! recomputed by angle weighting as Mitsuba's `Mesh::recompute_vertex_normals` does.
+//!
+//! The shading frame's tangent `s` follows dp/du as Mitsuba 3.9.1 computes it (checked against its
+//! hits in `tests/shading_frame.rs`): with uvs, dp/du of the triangle's uv parametrisation, or the
+//! first vector of `coordinate_system(face normal before flip_normals)` where the uv triangle is
+//! degenerate; without uvs, uv = (b1, b2) and dp/du = p1 − p0; then Gram–Schmidt against the
+//! shading normal (`interaction::shading_frame`). Face normals and uv tangents do not change per
+//! sample: they are computed once at load.
 
 use super::mesh_data::MeshData;
 use super::{obj, ply, serialized, Geometry};
-use crate::interaction::{PositionSample, SurfaceInteraction};
+use crate::interaction::{shading_frame, PositionSample, SurfaceInteraction};
 use crate::math::{warp, Aabb, Frame, Mat4, Vec2, Vec3};
 use crate::scene::desc::ObjectDesc;
 use crate::scene::resolver::FileResolver;
@@ -21,6 +28,11 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     pub indices: Vec<[u32; 3]>,
     pub flip_normals: bool,
+    /// Unit face normal per triangle from the winding, before `flip_normals` (zero if degenerate).
+    pub face_normals: Vec<Vec3>,
+    /// dp/du of each triangle's uv parametrisation (zero where the uv triangle is degenerate);
+    /// empty when the mesh has no uvs (then dp/du = p1 − p0 of the barycentric uv).
+    pub face_dp_du: Vec<Vec3>,
     /// Cumulative triangle areas (for area sampling); last entry = total area.
     area_cdf: Vec<f32>,
 }
@@ -29,10 +41,20 @@ impl Mesh {
     /// Transform loaded data into world space. `face_normals` drops vertex normals.
     pub fn new(data: MeshData, to_world: &Mat4, face_normals: bool, flip_normals: bool) -> Mesh {
         let positions: Vec<Vec3> = data.positions.iter().map(|p| to_world.transform_point3(*p)).collect();
+        let face_n: Vec<Vec3> = data
+            .indices
+            .iter()
+            .map(|idx| {
+                let [p0, p1, p2] = idx.map(|i| positions[i as usize]);
+                (p1 - p0).cross(p2 - p0).normalize_or_zero()
+            })
+            .collect();
+        let face_dp_du =
+            if data.uvs.is_empty() { Vec::new() } else { uv_tangents(&positions, &data.uvs, &data.indices) };
         let normals = if face_normals {
             Vec::new()
         } else if data.normals.is_empty() {
-            recompute_vertex_normals(&positions, &data.indices)
+            recompute_vertex_normals(&positions, &data.indices, &face_n)
         } else {
             let inv_t = to_world.inverse().transpose();
             data.normals
@@ -55,7 +77,16 @@ impl Mesh {
             total += 0.5 * (b - a).cross(c - a).length() as f64;
             area_cdf.push(total as f32);
         }
-        Mesh { positions, normals, uvs: data.uvs, indices: data.indices, flip_normals, area_cdf }
+        Mesh {
+            positions,
+            normals,
+            uvs: data.uvs,
+            indices: data.indices,
+            flip_normals,
+            face_normals: face_n,
+            face_dp_du,
+            area_cdf,
+        }
     }
 
     pub fn surface_area(&self) -> f32 {
@@ -82,11 +113,12 @@ impl Mesh {
     /// Position, geometric normal (flipped with `flip_normals`) and uv of the point at
     /// barycentrics (b1, b2) of triangle `prim`.
     #[inline(always)]
-    fn point(&self, idx: [u32; 3], b1: f32, b2: f32) -> (Vec3, Vec3, Vec2) {
+    fn point(&self, prim: u32, b1: f32, b2: f32) -> (Vec3, Vec3, Vec2) {
+        let idx = self.indices[prim as usize];
         let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
         let b0 = 1.0 - b1 - b2;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        let n = self.face_normals[prim as usize];
         let uv = if self.uvs.is_empty() {
             Vec2::new(b1, b2)
         } else {
@@ -99,23 +131,35 @@ impl Mesh {
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
         let idx = self.indices[prim as usize];
-        let (p, n, uv) = self.point(idx, b1, b2);
-        let mut sh_n = if self.normals.is_empty() {
+        let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
+        let b0 = 1.0 - b1 - b2;
+        let p = p0 * b0 + p1 * b1 + p2 * b2;
+        let face_n = self.face_normals[prim as usize];
+        let n = if self.flip_normals { -face_n } else { face_n };
+        let (uv, dp_du) = if self.uvs.is_empty() {
+            // uv = (b1, b2): dp/du = p1 − p0.
+            (Vec2::new(b1, b2), p1 - p0)
+        } else {
+            let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
+            let dp_du = self.face_dp_du[prim as usize];
+            // A degenerate uv triangle: coordinate_system(face normal before flipping).
+            let dp_du = if dp_du == Vec3::ZERO { Frame::from_normal(face_n).s } else { dp_du };
+            (u0 * b0 + u1 * b1 + u2 * b2, dp_du)
+        };
+        let sh_n = if self.normals.is_empty() {
             n
         } else {
-            let b0 = 1.0 - b1 - b2;
             let [n0, n1, n2] = idx.map(|i| self.normals[i as usize]);
             let sh_n = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
-            if self.flip_normals {
+            if sh_n == Vec3::ZERO {
+                n
+            } else if self.flip_normals {
                 -sh_n
             } else {
                 sh_n
             }
         };
-        if sh_n == Vec3::ZERO {
-            sh_n = n;
-        }
-        let sh_frame = Frame::from_normal(sh_n);
+        let sh_frame = shading_frame(sh_n, dp_du);
         SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray_d), shape: 0, prim }
     }
 
@@ -128,17 +172,38 @@ impl Mesh {
         let area = self.area_cdf[prim] - lo;
         let sx = if area > 0.0 { ((target - lo) / area).clamp(0.0, 1.0 - f32::EPSILON) } else { 0.5 };
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
-        let (p, n, uv) = self.point(self.indices[prim], b.x, b.y);
+        let (p, n, uv) = self.point(prim as u32, b.x, b.y);
         PositionSample { p, n, uv, pdf: 1.0 / total }
     }
 }
 
-/// Angle-weighted vertex normals (Mitsuba's `recompute_vertex_normals`).
-pub fn recompute_vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+/// dp/du of each triangle's uv parametrisation (Mitsuba's `Mesh::compute_surface_interaction`):
+/// with dp0 = p1 − p0, dp1 = p2 − p0, duv0 = uv1 − uv0, duv1 = uv2 − uv0,
+/// dp/du = (duv1.y dp0 − duv0.y dp1) / det, det = duv0.x duv1.y − duv0.y duv1.x; zero when det = 0.
+pub fn uv_tangents(positions: &[Vec3], uvs: &[Vec2], indices: &[[u32; 3]]) -> Vec<Vec3> {
+    indices
+        .iter()
+        .map(|idx| {
+            let [p0, p1, p2] = idx.map(|i| positions[i as usize]);
+            let [u0, u1, u2] = idx.map(|i| uvs[i as usize]);
+            let (dp0, dp1) = (p1 - p0, p2 - p0);
+            let (duv0, duv1) = (u1 - u0, u2 - u0);
+            let det = duv0.x * duv1.y - duv0.y * duv1.x;
+            let dp_du = (dp0 * duv1.y - dp1 * duv0.y) / det;
+            if det != 0.0 && dp_du.is_finite() {
+                dp_du
+            } else {
+                Vec3::ZERO
+            }
+        })
+        .collect()
+}
+
+/// Angle-weighted vertex normals (Mitsuba's `recompute_vertex_normals`), from the unit face normals.
+pub fn recompute_vertex_normals(positions: &[Vec3], indices: &[[u32; 3]], face_normals: &[Vec3]) -> Vec<Vec3> {
     let mut normals = vec![Vec3::ZERO; positions.len()];
-    for idx in indices {
+    for (idx, &face_n) in indices.iter().zip(face_normals) {
         let v = idx.map(|i| positions[i as usize]);
-        let face_n = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
         if face_n == Vec3::ZERO {
             continue;
         }

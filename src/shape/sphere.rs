@@ -5,18 +5,46 @@
 //! ```
 //! Seen from outside, emitters on it are sampled by the cone of directions it subtends (uniform in
 //! solid angle), as Mitsuba does; from inside, by area.
+//!
+//! Its parametrisation is Mitsuba's, in object space (`to_world` · translate(`center`) ·
+//! scale(`radius`), so a rotation turns it): uv = (φ / 2π, θ / π) of the local point, and
+//! dp/du = to_world (−y, x, 0), which orients the shading frame's tangent (anisotropic BSDFs).
 
-use crate::interaction::{DirectionSample, PositionSample, SurfaceInteraction};
-use crate::math::{warp, Aabb, Frame, Ray, Vec2, Vec3, INV_PI, INV_TWO_PI, PI};
+use crate::interaction::{shading_frame, DirectionSample, PositionSample, SurfaceInteraction};
+use crate::math::{warp, Aabb, Frame, Mat4, Ray, Vec2, Vec3, INV_PI, INV_TWO_PI, PI};
 
 #[derive(Clone, Debug)]
 pub struct Sphere {
+    /// World-space centre and radius.
     pub center: Vec3,
     pub radius: f32,
     pub flip_normals: bool,
+    /// Unit sphere → world (Mitsuba's `m_to_world`: `to_world` · translate(center) · scale(radius)).
+    pub to_world: Mat4,
+    pub to_object: Mat4,
+    /// Whether samples on the sphere need their uv: set by the scene when an area emitter with a
+    /// textured radiance sits on it; otherwise sampling skips the acos / atan2.
+    pub sample_uv: bool,
 }
 
 impl Sphere {
+    /// A sphere in world space without rotation (`to_world` = translate(center) · scale(radius)).
+    pub fn new(center: Vec3, radius: f32, flip_normals: bool) -> Sphere {
+        Sphere::with_to_world(Mat4::from_translation(center) * Mat4::from_scale(Vec3::splat(radius)), flip_normals)
+    }
+
+    /// The sphere that `to_world` (uniform scale) makes of the unit sphere at the origin.
+    pub fn with_to_world(to_world: Mat4, flip_normals: bool) -> Sphere {
+        Sphere {
+            center: to_world.transform_point3(Vec3::ZERO),
+            radius: to_world.transform_vector3(Vec3::X).length(),
+            flip_normals,
+            to_world,
+            to_object: to_world.inverse(),
+            sample_uv: true,
+        }
+    }
+
     pub fn bounds(&self) -> Aabb {
         Aabb { min: self.center - Vec3::splat(self.radius), max: self.center + Vec3::splat(self.radius) }
     }
@@ -56,14 +84,24 @@ impl Sphere {
         }
     }
 
-    fn local_uv(&self, p: Vec3) -> Vec2 {
-        let l = (p - self.center) / self.radius;
-        let theta = l.z.clamp(-1.0, 1.0).acos();
-        let mut phi = l.y.atan2(l.x);
+    /// uv = (φ / 2π, θ / π) of a point on the unit sphere in object space.
+    fn local_uv(local: Vec3) -> Vec2 {
+        let theta = local.z.clamp(-1.0, 1.0).acos();
+        let mut phi = local.y.atan2(local.x);
         if phi < 0.0 {
             phi += 2.0 * PI;
         }
         Vec2::new(phi * INV_TWO_PI, theta * INV_PI)
+    }
+
+    /// uv of a world-space point on the sphere, or zero when sampling does not need it.
+    #[inline]
+    fn sample_uv_of(&self, p: Vec3) -> Vec2 {
+        if self.sample_uv {
+            Self::local_uv(self.to_object.transform_point3(p))
+        } else {
+            Vec2::ZERO
+        }
     }
 
     pub fn interaction(&self, t: f32, ray: &Ray) -> SurfaceInteraction {
@@ -71,11 +109,14 @@ impl Sphere {
         let mut n = (hit - self.center).normalize();
         // Re-project onto the surface to reduce error (as Mitsuba does).
         let p = self.center + n * self.radius;
-        let uv = self.local_uv(p);
+        let local = self.to_object.transform_point3(p);
+        let uv = Self::local_uv(local);
+        // Mitsuba's dp/du = to_world (−y, x, 0) · 2π (zero at the poles: then coordinate_system(n)).
+        let dp_du = self.to_world.transform_vector3(Vec3::new(-local.y, local.x, 0.0));
         if self.flip_normals {
             n = -n;
         }
-        let sh_frame = Frame::from_normal(n);
+        let sh_frame = shading_frame(n, dp_du);
         SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray.d), shape: 0, prim: 0 }
     }
 
@@ -85,7 +126,7 @@ impl Sphere {
         PositionSample {
             p,
             n: if self.flip_normals { -d } else { d },
-            uv: self.local_uv(p),
+            uv: self.sample_uv_of(p),
             pdf: 1.0 / self.surface_area(),
         }
     }
@@ -115,7 +156,7 @@ impl Sphere {
                 n = -n;
             }
             let pdf = warp::square_to_uniform_cone_pdf(local, cos_alpha);
-            DirectionSample { p, n, uv: self.local_uv(p), d, dist: t, pdf, delta: false, emitter: 0 }
+            DirectionSample { p, n, uv: self.sample_uv_of(p), d, dist: t, pdf, delta: false, emitter: 0 }
         } else {
             let ps = self.sample_position(sample);
             area_to_direction_sample(ref_p, ps)
@@ -175,7 +216,8 @@ impl Sphere {
         if (sx - sy).abs() > 1e-4 * sx || (sx - sz).abs() > 1e-4 * sx {
             return Err(props.error("to_world", "sphere: to_world must not contain a non-uniform scale"));
         }
-        Ok(Sphere { center: to_world.transform_point3(center), radius: radius * sx, flip_normals })
+        let m = *to_world * Mat4::from_translation(center) * Mat4::from_scale(Vec3::splat(radius));
+        Ok(Sphere::with_to_world(m, flip_normals))
     }
 }
 
@@ -208,7 +250,7 @@ mod tests {
         for i in 0..200_000 {
             let center = (Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) - 0.5) * 200.0;
             let radius = 0.01 * 1000f32.powf(s.next_1d());
-            let sphere = Sphere { center, radius, flip_normals: false };
+            let sphere = Sphere::new(center, radius, false);
             let dir = warp::square_to_uniform_sphere(s.next_2d());
             let dist = if i % 3 == 0 { radius * s.next_1d() * 0.999 } else { radius * (1.0 + 1000.0 * s.next_1d()) };
             let o = center + dir * dist;
