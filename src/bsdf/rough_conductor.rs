@@ -19,10 +19,10 @@
 //! Mitsuba's `eval_1` does (see [`eval_1`](super::eval_1)). One-sided; one component: 0 = glossy
 //! reflection (flagged anisotropic when `alpha_u`/`alpha_v` are given, as in Mitsuba).
 //!
-//! Anisotropy follows the shading frame's tangent (local x = `alpha_u`). snee builds shading frames
-//! from the normal alone, Mitsuba from dp/du: the two tangents coincide on flat rectangles facing
-//! +Y or +Z (e.g. `rotate x -90` floors), elsewhere an anisotropic highlight is rotated about the
-//! normal relative to Mitsuba's.
+//! Anisotropy follows the shading frame's tangent (local x = `alpha_u`), which is Mitsuba's dp/du
+//! (`interaction::shading_frame`): a mesh's uv parametrisation (p1 − p0 without uvs), a sphere's
+//! φ direction in its own rotated frame, a disk's radial direction (`tests/shading_frame.rs`,
+//! scene `surfaces_anisotropic`).
 //!
 //! ```xml
 //! <bsdf type="roughconductor">
