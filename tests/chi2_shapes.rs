@@ -47,20 +47,12 @@ fn check(name: &str, s: Shape, ref_p: Vec3) {
 
 #[test]
 fn sphere_from_outside_cone_sampling() {
-    check(
-        "sphere outside",
-        shape(Geometry::Sphere(Sphere { center: Vec3::new(0.3, 0.2, 2.0), radius: 1.0, flip_normals: false })),
-        Vec3::ZERO,
-    );
+    check("sphere outside", shape(Geometry::Sphere(Sphere::new(Vec3::new(0.3, 0.2, 2.0), 1.0, false))), Vec3::ZERO);
 }
 
 #[test]
 fn sphere_from_inside_area_sampling() {
-    check(
-        "sphere inside",
-        shape(Geometry::Sphere(Sphere { center: Vec3::new(0.3, 0.2, 0.1), radius: 1.0, flip_normals: false })),
-        Vec3::ZERO,
-    );
+    check("sphere inside", shape(Geometry::Sphere(Sphere::new(Vec3::new(0.3, 0.2, 0.1), 1.0, false))), Vec3::ZERO);
 }
 
 #[test]
