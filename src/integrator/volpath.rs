@@ -182,13 +182,15 @@ pub struct Stages<'s, 'a> {
 }
 
 /// What an estimator's call needs besides its own arguments: the scene, the hero channel, the
-/// medium the path is in, the path's sample stream and the statistics.
-pub struct Cx<'a> {
+/// medium the path is in, the path's sample stream, the statistics, and the connection stages
+/// that weigh forward contributions at surfaces.
+pub struct Cx<'a, 's, 'b> {
     pub scene: &'a Scene,
     pub channel: usize,
     pub medium: Option<u32>,
     pub sampler: &'a mut Sampler,
     pub stats: &'a mut LocalStats,
+    pub stages: Stages<'s, 'b>,
 }
 
 /// What the path loop asks of its estimator at each event (`volpath`: [`Beta`]; `volpathmis`: its
@@ -206,16 +208,10 @@ pub trait PathWeight {
     /// Phase sampling gave `(weight, pdf)`; `false` ends the path.
     fn phase_sampled(&mut self, phase_weight: f32, phase_pdf: f32) -> bool;
     /// The contribution of an emitter hit by the path.
-    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit, stages: Stages) -> Spectrum;
+    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit) -> Spectrum;
     /// Emitter sampling at a surface `s` with a smooth BSDF: its contribution and the direction
     /// towards the emitter sample.
-    fn surface_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        s: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        stages: Stages,
-    ) -> (Spectrum, Vec3);
+    fn surface_emitter_sampling(&mut self, cx: &mut Cx, s: &SurfaceInteraction, bsdf: &Bsdf) -> (Spectrum, Vec3);
     /// Is this BSDF sample usable? (Else the path ends, as a failed sample does.)
     fn accepts(&self, bs: &BsdfSample) -> bool;
     /// The path's `valid_ray` after BSDF sampling failed at `bsdf`.
@@ -300,7 +296,7 @@ impl PathWeight for Beta {
     }
 
     #[inline]
-    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit, stages: Stages) -> Spectrum {
+    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit) -> Spectrum {
         let (scene, channel, stats) = (cx.scene, cx.channel, &mut *cx.stats);
         // An emitter with zero radiance toward us is no hit (nor a suffix for SNEE to weigh).
         if hit.le == Spectrum::ZERO {
@@ -310,11 +306,11 @@ impl PathWeight for Beta {
         let p_light = std::cell::OnceCell::new();
         let p_light = || *p_light.get_or_init(|| scene.pdf_emitter_direction(hit.from, &hit.ds));
         let mut w = if hit.count_direct { 1.0 } else { mis_weight(self.last_scatter_pdf, p_light()) };
-        if let Some(snee) = stages.snee {
+        if let Some(snee) = cx.stages.snee {
             let light = || LightSample::hit(hit.ray_d, hit.light_p, hit.ds.dist, p_light());
             w = snee.weight(scene, ForwardTechnique::Bsdf, light, w, channel, stats);
             // An escape right after leaving x_j's medium is shared with the manifold connection.
-            if let Some(wm) = stages.manifold.and_then(|m| m.weight(scene, snee, hit.ray_d, channel, stats)) {
+            if let Some(wm) = cx.stages.manifold.and_then(|m| m.weight(scene, snee, hit.ray_d, channel, stats)) {
                 w = wm;
             }
         }
@@ -322,13 +318,7 @@ impl PathWeight for Beta {
     }
 
     #[inline]
-    fn surface_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        s: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        stages: Stages,
-    ) -> (Spectrum, Vec3) {
+    fn surface_emitter_sampling(&mut self, cx: &mut Cx, s: &SurfaceInteraction, bsdf: &Bsdf) -> (Spectrum, Vec3) {
         let (scene, channel, medium) = (cx.scene, cx.channel, cx.medium);
         let (sampler, stats) = (&mut *cx.sampler, &mut *cx.stats);
         if scene.emitters.is_empty() {
@@ -340,7 +330,7 @@ impl PathWeight for Beta {
         }
         let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&BsdfContext::default(), s, s.to_local(ds.d));
         let mut w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { bsdf_pdf });
-        if let Some(snee) = stages.snee {
+        if let Some(snee) = cx.stages.snee {
             w = snee.weight(scene, ForwardTechnique::Nee, || LightSample::sampled(&ds), w, channel, stats);
         }
         (self.beta * bsdf_val * w * emitted, ds.d)
@@ -437,7 +427,12 @@ pub fn trace<W: PathWeight, T: Tally>(
                 tally.medium_vertex(p, mi);
 
                 // ---- Emitter sampling at the medium vertex ----
-                let c = weight.medium_emitter_sampling(&mut Cx { scene, channel, medium, sampler, stats }, m, p, wi);
+                let c = weight.medium_emitter_sampling(
+                    &mut Cx { scene, channel, medium, sampler, stats, stages: Stages::default() },
+                    m,
+                    p,
+                    wi,
+                );
                 if keep_all {
                     result += c;
                     tally.add(scene, c, End::MediumNee);
@@ -508,7 +503,7 @@ pub fn trace<W: PathWeight, T: Tally>(
         };
         let stages = Stages { snee: snee.as_ref(), manifold: manifold.as_ref() };
         if let (false, Some(hit)) = (hide, hit) {
-            let c = weight.emitter_hit(&mut Cx { scene, channel, medium, sampler, stats }, &hit, stages);
+            let c = weight.emitter_hit(&mut Cx { scene, channel, medium, sampler, stats, stages }, &hit);
             result += c;
             tally.add(scene, c, End::Hit);
         }
@@ -517,8 +512,8 @@ pub fn trace<W: PathWeight, T: Tally>(
 
         // ---- Emitter sampling at the surface ----
         if bsdf.flags() & flags::SMOOTH != 0 && depth + 1 < max_depth {
-            let cx = &mut Cx { scene, channel, medium, sampler, stats };
-            let (c, light_d) = weight.surface_emitter_sampling(cx, &s, bsdf, stages);
+            let cx = &mut Cx { scene, channel, medium, sampler, stats, stages };
+            let (c, light_d) = weight.surface_emitter_sampling(cx, &s, bsdf);
             result += c;
             tally.add(scene, c, End::SurfaceNee { s: &s, d: ray.d, light_d });
         }

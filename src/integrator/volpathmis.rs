@@ -45,7 +45,7 @@
 
 use super::classes::{NoClasses, Tally};
 use super::stats::LocalStats;
-use super::volpath::{trace, Cx, EmitterHit, PathWeight, Stages};
+use super::volpath::{trace, Cx, EmitterHit, PathWeight};
 use super::walk::{shadow_ray, walk_segments, PathSetup, RefPoint};
 use crate::bsdf::{Bsdf, BsdfContext, BsdfSample};
 use crate::color::Spectrum;
@@ -301,7 +301,7 @@ impl PathWeight for SpectralMis {
     }
 
     #[inline]
-    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit, _: Stages) -> Spectrum {
+    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit) -> Spectrum {
         let scene = cx.scene;
         let w = if hit.count_direct {
             self.p_over_f.weight()
@@ -314,13 +314,7 @@ impl PathWeight for SpectralMis {
     }
 
     #[inline]
-    fn surface_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        s: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        _: Stages,
-    ) -> (Spectrum, Vec3) {
+    fn surface_emitter_sampling(&mut self, cx: &mut Cx, s: &SurfaceInteraction, bsdf: &Bsdf) -> (Spectrum, Vec3) {
         let (scene, channel, medium) = (cx.scene, cx.channel, cx.medium);
         let (sampler, stats) = (&mut *cx.sampler, &mut *cx.stats);
         let (mut nee_end, mut uni_end, emitted, ds) =
