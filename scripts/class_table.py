@@ -51,8 +51,10 @@ def scene_file(config, method, out):
     with open(src) as f:
         xml = f.read()
     xml = xml.replace('<integrator type="$integrator">', f'<integrator type="{integrator}">{extra}')
-    # Next to the original so that statue.ply and sun_sky.exr resolve.
-    path = os.path.join(ROOT, "scenes", "paper", f".class_table_{config}_{method}.xml")
+    # Written to `out`, with the assets (statue.ply, sun_sky.exr) by absolute path.
+    for asset in ("statue.ply", "sun_sky.exr"):
+        xml = xml.replace(f'value="{asset}"', f'value="{os.path.join(ROOT, "scenes", "paper", asset)}"')
+    path = os.path.join(out, f"{config}_{method}.xml")
     with open(path, "w") as f:
         f.write(xml)
     return path
@@ -99,14 +101,11 @@ def main():
     for config in args.configs:
         for method in args.methods:
             scene = scene_file(config, method, args.out)
-            try:
-                runs = []
-                for seed in range(args.seeds):
-                    exr = os.path.join(args.out, f"{config}_{method}_s{seed}.exr")
-                    runs.append(shares(render(args.snee, scene, exr, args.spp, seed, args.width, args.height,
-                                              args.threads)))
-            finally:
-                os.remove(scene)
+            runs = []
+            for seed in range(args.seeds):
+                exr = os.path.join(args.out, f"{config}_{method}_s{seed}.exr")
+                runs.append(shares(render(args.snee, scene, exr, args.spp, seed, args.width, args.height,
+                                          args.threads)))
             row = {}
             for k in CLASSES:
                 e = [r[0][k] for r in runs]

@@ -265,7 +265,7 @@ impl PathWeight for Beta {
         self.beta *= m.sigma_s();
     }
 
-    #[inline]
+    #[inline(always)]
     fn medium_emitter_sampling(&mut self, cx: &mut Cx, m: &Homogeneous, p: Vec3, wi: Vec3) -> Spectrum {
         let (scene, channel, medium) = (cx.scene, cx.channel, cx.medium);
         let (sampler, stats) = (&mut *cx.sampler, &mut *cx.stats);
