@@ -260,7 +260,7 @@ pub fn render_range(
             let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
             let aperture = sampler.next_2d();
             let ray = scene.camera.sample_ray(pos, aperture);
-            let finite = |l: Spectrum| l.is_finite() && !(moment && !(l * l).is_finite());
+            let finite = |l: Spectrum| l.is_finite() && (!moment || (l * l).is_finite());
             match split {
                 None => {
                     let (mut l, valid) = sample_li(scene, sampler, ray, local);
