@@ -67,6 +67,10 @@ enum Command {
         /// Also write the per-pixel second moment (channels m2.R, m2.G, m2.B), as Mitsuba's `moment`.
         #[arg(long)]
         moment: bool,
+        /// Also write the image split by transport class (channels `<class>.R/G/B`, with --moment
+        /// also `<class>.m2.R/G/B`; classes in docs/classes.md).
+        #[arg(long)]
+        classes: bool,
         /// Reference image for --convergence.
         #[arg(long, value_name = "REF.exr", requires = "convergence")]
         reference: Option<PathBuf>,
@@ -177,6 +181,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             png,
             quiet,
             moment,
+            classes,
             reference,
             convergence,
             sample_range,
@@ -196,9 +201,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 None => false,
             };
             let part_mode = sample_range.is_some() || checkpoint.is_some() || resume.is_some();
-            if output_png && (part_mode || moment) {
+            if output_png && (part_mode || moment || classes) {
                 return Err(anyhow!(
-                    "-o {}: --moment, --sample-range, --checkpoint and --resume need an .exr output (PNG holds 8-bit colour only)",
+                    "-o {}: --moment, --classes, --sample-range, --checkpoint and --resume need an .exr output (PNG holds 8-bit colour only)",
                     output.as_deref().unwrap_or(Path::new("")).display()
                 ));
             }
@@ -210,6 +215,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             }
             let mut loaded = load_scene(&scene_path, &defines)?;
             loaded.integrator.moment |= moment;
+            loaded.integrator.classes |= classes;
             if let Some(t) = time {
                 if !(t > 0.0 && t.is_finite()) {
                     return Err(anyhow!("--time expects a positive number of seconds"));

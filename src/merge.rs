@@ -58,6 +58,8 @@ pub struct PartMeta {
     pub crop: [u32; 4],
     /// Second moments (`m2.*` channels) present.
     pub moment: bool,
+    /// Transport-class channel groups (`--classes`) present.
+    pub classes: bool,
     /// snee version that rendered the part (informative).
     pub version: String,
 }
@@ -76,6 +78,7 @@ impl PartMeta {
             "film": [self.film.0, self.film.1],
             "crop": self.crop,
             "moment": self.moment,
+            "classes": self.classes,
             "version": self.version,
         })
     }
@@ -122,13 +125,15 @@ impl PartMeta {
             film: pair("film")?,
             crop,
             moment: v["moment"].as_bool().ok_or("field \"moment\" missing or not a boolean")?,
+            // Absent in parts written before `--classes` existed.
+            classes: v["classes"].as_bool().unwrap_or(false),
             version: s("version").unwrap_or_default(),
         })
     }
 
     /// `Err` naming the first field (other than the range) in which `other` differs.
     pub fn check_same_run(&self, other: &PartMeta) -> Result<(), String> {
-        let fields: [(&str, String, String); 7] = [
+        let fields: [(&str, String, String); 8] = [
             ("scene (file contents and -D defines)", self.scene_hash.clone(), other.scene_hash.clone()),
             ("integrator", self.integrator.clone(), other.integrator.clone()),
             ("seed", self.seed.to_string(), other.seed.to_string()),
@@ -136,6 +141,7 @@ impl PartMeta {
             ("film size", format!("{}x{}", self.film.0, self.film.1), format!("{}x{}", other.film.0, other.film.1)),
             ("crop window", format!("{:?}", self.crop), format!("{:?}", other.crop)),
             ("moment", self.moment.to_string(), other.moment.to_string()),
+            ("classes", self.classes.to_string(), other.classes.to_string()),
         ];
         for (name, a, b) in fields {
             if a != b {
@@ -429,6 +435,7 @@ impl PartRender {
             film: (film.width, film.height),
             crop: [film.crop_offset.0, film.crop_offset.1, film.crop_size.0, film.crop_size.1],
             moment: scene.integrator.moment,
+            classes: scene.integrator.classes,
             version: env!("CARGO_PKG_VERSION").to_string(),
         };
         let resumed = match resume {
@@ -516,6 +523,7 @@ mod tests {
             film: (2, 1),
             crop: [0, 0, 2, 1],
             moment: false,
+            classes: false,
             version: "x".into(),
         }
     }

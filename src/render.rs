@@ -12,6 +12,7 @@
 //! full image up to float summation order (`merge`).
 
 use crate::color::Spectrum;
+use crate::integrator::classes::{ClassValues, PathClass, N_CLASSES};
 use crate::integrator::stats::{LocalStats, Stats};
 use crate::integrator::IntegratorKind;
 use crate::math::Vec2;
@@ -202,7 +203,8 @@ pub fn render_range(
     let ((sx, sy), (sw, sh)) = film.sample_window();
     let rgba = matches!(film.pixel_format, PixelFormat::Rgba);
     let moment = scene.integrator.moment;
-    // Channels: RGB, [A], [second moment of RGB].
+    let classes = scene.integrator.classes;
+    // Channels: RGB, [A], [second moment of RGB], [per transport class: RGB, [second moment]].
     let mut channels: Vec<String> = vec!["R".into(), "G".into(), "B".into()];
     if rgba {
         channels.push("A".into());
@@ -210,6 +212,15 @@ pub fn render_range(
     if moment {
         for c in ["R", "G", "B"] {
             channels.push(format!("m2.{}", c));
+        }
+    }
+    if classes {
+        for class in PathClass::ALL {
+            for prefix in if moment { ["", "m2."].as_slice() } else { [""].as_slice() } {
+                for c in ["R", "G", "B"] {
+                    channels.push(format!("{}.{prefix}{c}", class.name()));
+                }
+            }
         }
     }
     let nch = channels.len();
@@ -242,20 +253,38 @@ pub fn render_range(
         indicatif::ProgressBar::hidden()
     };
 
-    // One camera sample: film position, radiance (zero and counted when not finite), validity.
-    let take_sample = |sampler: &mut Sampler, local: &mut LocalStats, x: i32, y: i32| {
-        let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-        let aperture = sampler.next_2d();
-        let ray = scene.camera.sample_ray(pos, aperture);
-        let (mut l, valid) = sample_li(scene, sampler, ray, local);
-        l *= ray_weight;
-        // With `moment`, a sample whose square overflows (|l| > ~1.8e19) would write inf into m2.*.
-        if !l.is_finite() || (moment && !(l * l).is_finite()) {
-            local.rejected_samples += 1;
-            l = Spectrum::ZERO;
-        }
-        (pos, l, valid)
-    };
+    // One camera sample: film position, radiance (zero and counted when not finite), validity;
+    // with `split`, also the radiance by transport class.
+    let take_sample =
+        |sampler: &mut Sampler, local: &mut LocalStats, x: i32, y: i32, split: Option<&mut ClassValues>| {
+            let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+            let aperture = sampler.next_2d();
+            let ray = scene.camera.sample_ray(pos, aperture);
+            let finite = |l: Spectrum| l.is_finite() && (!moment || (l * l).is_finite());
+            match split {
+                None => {
+                    let (mut l, valid) = sample_li(scene, sampler, ray, local);
+                    l *= ray_weight;
+                    // With `moment`, a sample whose square overflows (|l| > ~1.8e19) would write inf into m2.*.
+                    if !finite(l) {
+                        local.rejected_samples += 1;
+                        l = Spectrum::ZERO;
+                    }
+                    (pos, l, valid)
+                }
+                Some(split) => {
+                    let (mut l, valid, values) = scene.integrator.li_classes(scene, sampler, ray, local);
+                    l *= ray_weight;
+                    *split = values.map(|v| v * ray_weight);
+                    if !finite(l) || !split.iter().all(|&v| finite(v)) {
+                        local.rejected_samples += 1;
+                        l = Spectrum::ZERO;
+                        *split = [Spectrum::ZERO; N_CLASSES];
+                    }
+                    (pos, l, valid)
+                }
+            }
+        };
 
     // Next sample index per pixel; the image holds samples start_sample..next.
     let mut next = start_sample;
@@ -303,6 +332,7 @@ pub fn render_range(
                 let mut local = LocalStats::default();
                 let mut replayed = LocalStats::default();
                 let mut values = vec![0.0f32; nch];
+                let mut split = [Spectrum::ZERO; N_CLASSES];
                 for y in y0..y0 + h as i32 {
                     for x in x0..x0 + w as i32 {
                         // Unique per film pixel (the border may lie outside the film: offset it).
@@ -310,10 +340,11 @@ pub fn render_range(
                         let mut sampler =
                             Sampler::new(opts.seed, pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(chunk as u64));
                         for _ in 0..replay {
-                            take_sample(&mut sampler, &mut replayed, x, y);
+                            take_sample(&mut sampler, &mut replayed, x, y, classes.then_some(&mut split));
                         }
                         for _ in 0..pass_spp {
-                            let (pos, l, valid) = take_sample(&mut sampler, &mut local, x, y);
+                            let (pos, l, valid) =
+                                take_sample(&mut sampler, &mut local, x, y, classes.then_some(&mut split));
                             values[..3].copy_from_slice(&l.to_array());
                             let mut k = 3;
                             if rgba {
@@ -322,6 +353,17 @@ pub fn render_range(
                             }
                             if moment {
                                 values[k..k + 3].copy_from_slice(&(l * l).to_array());
+                                k += 3;
+                            }
+                            if classes {
+                                for v in &split {
+                                    values[k..k + 3].copy_from_slice(&v.to_array());
+                                    k += 3;
+                                    if moment {
+                                        values[k..k + 3].copy_from_slice(&(*v * *v).to_array());
+                                        k += 3;
+                                    }
+                                }
                             }
                             block.put(pos, &values);
                         }

@@ -28,6 +28,8 @@ pub struct IntegratorDesc {
     pub hide_emitters: bool,
     /// Wrapped in `moment`: also output the per-pixel second moment.
     pub moment: bool,
+    /// `snee render --classes`: also output the image split by transport class (`classes.rs`).
+    pub classes: bool,
     /// `volpath_snee`'s `snee`, `transport` and `snee_rate` options (defaults elsewhere).
     pub snee: SneeOptions,
     /// `volpath_snee`'s `connection`: the paper's estimator or the complete one (manifold NEE).
@@ -42,6 +44,7 @@ impl Default for IntegratorDesc {
             rr_depth: 5,
             hide_emitters: false,
             moment: false,
+            classes: false,
             snee: SneeOptions::default(),
             connection: Connection::default(),
         }

@@ -17,6 +17,7 @@
 //! | `rr_depth`      | integer | 5       | depth from which Russian roulette runs                 |
 //! | `hide_emitters` | boolean | false   | emitters seen directly are black                       |
 
+pub mod classes;
 pub mod desc;
 pub mod enclosure;
 pub mod manifold;
@@ -38,6 +39,7 @@ use crate::sampler::Sampler;
 use crate::scene::desc::ObjectDesc;
 use crate::scene::world::Scene;
 use crate::scene::{Error, Result};
+use classes::{ClassValues, Classes, PathClass};
 use stats::LocalStats;
 
 /// The settings of an `<integrator>` element (its common parameters, and its own).
@@ -84,6 +86,7 @@ pub fn parse(obj: &ObjectDesc) -> Result<IntegratorDesc> {
         rr_depth: clamp(rr_depth),
         hide_emitters,
         moment: false,
+        classes: false,
         snee,
         connection,
     })
@@ -114,5 +117,33 @@ impl Integrator {
             Integrator::Volpathmis(_) => volpathmis::li(scene, sampler, ray, medium, stats),
             Integrator::VolpathSnee(_, snee) => volpath_snee::li(scene, snee, sampler, ray, medium, stats),
         }
+    }
+
+    /// [`Integrator::li`], also split by transport class (`classes.rs`; `path`: all `surface`).
+    pub fn li_classes(
+        &self,
+        scene: &Scene,
+        sampler: &mut Sampler,
+        ray: Ray,
+        stats: &mut LocalStats,
+    ) -> (Spectrum, bool, ClassValues) {
+        let medium = scene.sensor_medium;
+        let mut tally = Classes::default();
+        let (l, valid) = match self {
+            Integrator::Path(_) => {
+                let (l, valid) = path::li(scene, sampler, ray, stats);
+                tally.values[PathClass::Surface as usize] = l;
+                (l, valid)
+            }
+            Integrator::Volpath(_) => volpath::li_tally(scene, sampler, ray, medium, stats, None, &mut tally),
+            Integrator::Volpathmis(_) => {
+                let roulette = volpathmis::RouletteMis::Unbiased;
+                volpathmis::li_tally(scene, sampler, ray, medium, stats, roulette, &mut tally)
+            }
+            Integrator::VolpathSnee(_, snee) => {
+                volpath::li_tally(scene, sampler, ray, medium, stats, Some(snee), &mut tally)
+            }
+        };
+        (l, valid, tally.values)
     }
 }

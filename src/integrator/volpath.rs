@@ -21,6 +21,7 @@
 //! as one more stage ([`SneeStage`]), and with `connection = complete` manifold NEE as another
 //! ([`ManifoldStage`], `manifold/stage.rs`).
 
+use super::classes::{End, NoClasses, Tally};
 use super::manifold::ManifoldStage;
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
@@ -143,27 +144,53 @@ pub fn li_with(
     stats: &mut LocalStats,
     snee: Option<&Snee>,
 ) -> (Spectrum, bool) {
-    let weight = Beta { beta: Spectrum::ONE, last_scatter_pdf: 1.0 };
-    trace(scene, sampler, ray, medium, stats, weight, snee.map(SneeStage::new))
+    li_tally(scene, sampler, ray, medium, stats, snee, &mut NoClasses)
 }
 
-/// An emitter the path's ray hit: its radiance, the direction sample from the last scattering
-/// vertex `from` (for MIS densities), and the point SNEE's light record uses.
+/// [`li_with`], also adding every contribution to `tally` (transport classes, `classes.rs`).
+pub fn li_tally<T: Tally>(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    ray: Ray,
+    medium: Option<u32>,
+    stats: &mut LocalStats,
+    snee: Option<&Snee>,
+    tally: &mut T,
+) -> (Spectrum, bool) {
+    let weight = Beta { beta: Spectrum::ONE, last_scatter_pdf: 1.0 };
+    trace(scene, sampler, ray, medium, stats, weight, snee.map(SneeStage::new), tally)
+}
+
+/// An emitter the path's ray (along `ray_d`) hit: its radiance, the direction sample from the
+/// last scattering vertex `from` (for MIS densities), the point SNEE's light record uses, and
+/// whether it counts at full weight (`count_direct`: seen directly or after a specular chain).
 #[derive(Clone, Copy, Debug)]
 pub struct EmitterHit {
     pub le: Spectrum,
     pub ds: DirectionSample,
     pub from: Vec3,
     pub light_p: Vec3,
+    pub ray_d: Vec3,
+    pub count_direct: bool,
+}
+
+/// The connection stages of `volpath_snee` that weigh forward contributions (none elsewhere).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Stages<'s, 'a> {
+    pub snee: Option<&'s SneeStage<'a>>,
+    pub manifold: Option<&'s ManifoldStage<'a>>,
 }
 
 /// What an estimator's call needs besides its own arguments: the scene, the hero channel, the
-/// path's sample stream and the statistics.
-pub struct Cx<'a> {
+/// medium the path is in, the path's sample stream, the statistics, and the connection stages
+/// that weigh forward contributions at surfaces.
+pub struct Cx<'a, 's, 'b> {
     pub scene: &'a Scene,
     pub channel: usize,
+    pub medium: Option<u32>,
     pub sampler: &'a mut Sampler,
     pub stats: &'a mut LocalStats,
+    pub stages: Stages<'s, 'b>,
 }
 
 /// What the path loop asks of its estimator at each event (`volpath`: [`Beta`]; `volpathmis`: its
@@ -176,39 +203,15 @@ pub trait PathWeight {
     fn flight(&mut self, m: &Homogeneous, t: f32, t_surface: f32, scatter: bool, channel: usize);
     /// A real collision (albedo and the null-or-real decision).
     fn real_scatter(&mut self, m: &Homogeneous);
-    /// Emitter sampling at the medium vertex `p`: its contribution.
-    #[allow(clippy::too_many_arguments)]
-    fn medium_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        m: &Homogeneous,
-        p: Vec3,
-        wi: Vec3,
-        medium: Option<u32>,
-    ) -> Spectrum;
+    /// Emitter sampling at the medium vertex `p` (in `cx.medium`): its contribution.
+    fn medium_emitter_sampling(&mut self, cx: &mut Cx, m: &Homogeneous, p: Vec3, wi: Vec3) -> Spectrum;
     /// Phase sampling gave `(weight, pdf)`; `false` ends the path.
     fn phase_sampled(&mut self, phase_weight: f32, phase_pdf: f32) -> bool;
-    /// The contribution of an emitter hit by the path (`count_direct`: at full weight).
-    #[allow(clippy::too_many_arguments)]
-    fn emitter_hit(
-        &mut self,
-        cx: &mut Cx,
-        hit: &EmitterHit,
-        ray_d: Vec3,
-        count_direct: bool,
-        snee: Option<&SneeStage>,
-        manifold: Option<&ManifoldStage>,
-    ) -> Spectrum;
-    /// Emitter sampling at a surface `s` with a smooth BSDF: its contribution.
-    #[allow(clippy::too_many_arguments)]
-    fn surface_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        s: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        medium: Option<u32>,
-        snee: Option<&SneeStage>,
-    ) -> Spectrum;
+    /// The contribution of an emitter hit by the path.
+    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit) -> Spectrum;
+    /// Emitter sampling at a surface `s` with a smooth BSDF: its contribution and the direction
+    /// towards the emitter sample.
+    fn surface_emitter_sampling(&mut self, cx: &mut Cx, s: &SurfaceInteraction, bsdf: &Bsdf) -> (Spectrum, Vec3);
     /// Is this BSDF sample usable? (Else the path ends, as a failed sample does.)
     fn accepts(&self, bs: &BsdfSample) -> bool;
     /// The path's `valid_ray` after BSDF sampling failed at `bsdf`.
@@ -262,17 +265,10 @@ impl PathWeight for Beta {
         self.beta *= m.sigma_s();
     }
 
-    #[inline]
-    fn medium_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        m: &Homogeneous,
-        p: Vec3,
-        wi: Vec3,
-        medium: Option<u32>,
-    ) -> Spectrum {
-        let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
-
+    #[inline(always)]
+    fn medium_emitter_sampling(&mut self, cx: &mut Cx, m: &Homogeneous, p: Vec3, wi: Vec3) -> Spectrum {
+        let (scene, channel, medium) = (cx.scene, cx.channel, cx.medium);
+        let (sampler, stats) = (&mut *cx.sampler, &mut *cx.stats);
         if !m.sample_emitters {
             return Spectrum::ZERO;
         }
@@ -300,17 +296,8 @@ impl PathWeight for Beta {
     }
 
     #[inline]
-    fn emitter_hit(
-        &mut self,
-        cx: &mut Cx,
-        hit: &EmitterHit,
-        ray_d: Vec3,
-        count_direct: bool,
-        snee: Option<&SneeStage>,
-        manifold: Option<&ManifoldStage>,
-    ) -> Spectrum {
+    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit) -> Spectrum {
         let (scene, channel, stats) = (cx.scene, cx.channel, &mut *cx.stats);
-
         // An emitter with zero radiance toward us is no hit (nor a suffix for SNEE to weigh).
         if hit.le == Spectrum::ZERO {
             return Spectrum::ZERO;
@@ -318,12 +305,12 @@ impl PathWeight for Beta {
         // The emitter-sampling density of this direction, computed at most once.
         let p_light = std::cell::OnceCell::new();
         let p_light = || *p_light.get_or_init(|| scene.pdf_emitter_direction(hit.from, &hit.ds));
-        let mut w = if count_direct { 1.0 } else { mis_weight(self.last_scatter_pdf, p_light()) };
-        if let Some(snee) = snee {
-            let light = || LightSample::hit(ray_d, hit.light_p, hit.ds.dist, p_light());
+        let mut w = if hit.count_direct { 1.0 } else { mis_weight(self.last_scatter_pdf, p_light()) };
+        if let Some(snee) = cx.stages.snee {
+            let light = || LightSample::hit(hit.ray_d, hit.light_p, hit.ds.dist, p_light());
             w = snee.weight(scene, ForwardTechnique::Bsdf, light, w, channel, stats);
             // An escape right after leaving x_j's medium is shared with the manifold connection.
-            if let Some(wm) = manifold.and_then(|m| m.weight(scene, snee, ray_d, channel, stats)) {
+            if let Some(wm) = cx.stages.manifold.and_then(|m| m.weight(scene, snee, hit.ray_d, channel, stats)) {
                 w = wm;
             }
         }
@@ -331,29 +318,22 @@ impl PathWeight for Beta {
     }
 
     #[inline]
-    fn surface_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        s: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        medium: Option<u32>,
-        snee: Option<&SneeStage>,
-    ) -> Spectrum {
-        let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
-
+    fn surface_emitter_sampling(&mut self, cx: &mut Cx, s: &SurfaceInteraction, bsdf: &Bsdf) -> (Spectrum, Vec3) {
+        let (scene, channel, medium) = (cx.scene, cx.channel, cx.medium);
+        let (sampler, stats) = (&mut *cx.sampler, &mut *cx.stats);
         if scene.emitters.is_empty() {
-            return Spectrum::ZERO;
+            return (Spectrum::ZERO, Vec3::ZERO);
         }
         let (emitted, ds) = sample_emitter(scene, RefPoint::Surface(s), medium, channel, sampler, stats);
         if emitted == Spectrum::ZERO {
-            return Spectrum::ZERO;
+            return (Spectrum::ZERO, ds.d);
         }
         let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&BsdfContext::default(), s, s.to_local(ds.d));
         let mut w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { bsdf_pdf });
-        if let Some(snee) = snee {
+        if let Some(snee) = cx.stages.snee {
             w = snee.weight(scene, ForwardTechnique::Nee, || LightSample::sampled(&ds), w, channel, stats);
         }
-        self.beta * bsdf_val * w * emitted
+        (self.beta * bsdf_val * w * emitted, ds.d)
     }
 
     #[inline]
@@ -383,8 +363,10 @@ impl PathWeight for Beta {
 /// The volumetric path loop of `volpath`, `volpathmis` and `volpath_snee` (Mitsuba's volpath):
 /// Russian roulette, a free flight through the medium, at a real collision emitter sampling, SNEE
 /// and phase sampling; at a surface the emitter hit, emitter sampling and BSDF sampling. `weight`
-/// carries the estimator's weights, `snee` the SNEE stage (`volpath_snee` only).
-pub fn trace<W: PathWeight>(
+/// carries the estimator's weights, `snee` the SNEE stage (`volpath_snee` only); every
+/// contribution also goes to `tally` (transport classes; [`NoClasses`] does nothing).
+#[allow(clippy::too_many_arguments)]
+pub fn trace<W: PathWeight, T: Tally>(
     scene: &Scene,
     sampler: &mut Sampler,
     ray: Ray,
@@ -392,6 +374,7 @@ pub fn trace<W: PathWeight>(
     stats: &mut LocalStats,
     mut weight: W,
     mut snee: Option<SneeStage>,
+    tally: &mut T,
 ) -> (Spectrum, bool) {
     let desc = &scene.integrator;
     let ctx = BsdfContext::default();
@@ -441,22 +424,33 @@ pub fn trace<W: PathWeight>(
                 let wi = -ray.d;
                 valid_ray = true;
                 specular_chain = !m.sample_emitters;
+                tally.medium_vertex(p, mi);
 
                 // ---- Emitter sampling at the medium vertex ----
-                let c = weight.medium_emitter_sampling(&mut Cx { scene, channel, sampler, stats }, m, p, wi, medium);
+                let c = weight.medium_emitter_sampling(
+                    &mut Cx { scene, channel, medium, sampler, stats, stages: Stages::default() },
+                    m,
+                    p,
+                    wi,
+                );
                 if keep_all {
                     result += c;
+                    tally.add(scene, c, End::MediumNee);
                 }
 
                 // ---- Subdivision next-event estimation (volpath_snee) ----
                 if let Some(snee) = &mut snee {
                     let beta = weight.beta();
-                    result += snee.at_scatter(scene, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+                    let c = snee.at_scatter(scene, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+                    result += c;
+                    tally.add(scene, c, End::Snee);
 
                     // ---- Manifold next-event estimation (connection = complete) ----
                     if let Some(manifold) = &mut manifold {
-                        result += manifold
+                        let c = manifold
                             .at_scatter(scene, snee, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+                        result += c;
+                        tally.add(scene, c, End::Manifold);
                     }
                 }
 
@@ -494,37 +488,34 @@ pub fn trace<W: PathWeight>(
                 ds: scene.direction_sample_for_hit(last_scatter_p, s),
                 from: last_scatter_p,
                 light_p: s.p,
+                ray_d: ray.d,
+                count_direct,
             }),
             None => scene.environment.map(|env| EmitterHit {
                 le: scene.eval_environment(ray.d),
                 ds: scene.environment_direction_sample(env, ray.d),
                 from: last_scatter_p,
                 light_p: last_scatter_p,
+                ray_d: ray.d,
+                count_direct,
             }),
             _ => None,
         };
+        let stages = Stages { snee: snee.as_ref(), manifold: manifold.as_ref() };
         if let (false, Some(hit)) = (hide, hit) {
-            result += weight.emitter_hit(
-                &mut Cx { scene, channel, sampler, stats },
-                &hit,
-                ray.d,
-                count_direct,
-                snee.as_ref(),
-                manifold.as_ref(),
-            );
+            let c = weight.emitter_hit(&mut Cx { scene, channel, medium, sampler, stats, stages }, &hit);
+            result += c;
+            tally.add(scene, c, End::Hit);
         }
         let Some(s) = si else { break };
         let bsdf = scene.bsdf(&s);
 
         // ---- Emitter sampling at the surface ----
         if bsdf.flags() & flags::SMOOTH != 0 && depth + 1 < max_depth {
-            result += weight.surface_emitter_sampling(
-                &mut Cx { scene, channel, sampler, stats },
-                &s,
-                bsdf,
-                medium,
-                snee.as_ref(),
-            );
+            let cx = &mut Cx { scene, channel, medium, sampler, stats, stages };
+            let (c, light_d) = weight.surface_emitter_sampling(cx, &s, bsdf);
+            result += c;
+            tally.add(scene, c, End::SurfaceNee { s: &s, d: ray.d, light_d });
         }
 
         // ---- BSDF sampling ----
@@ -537,8 +528,11 @@ pub fn trace<W: PathWeight>(
         };
         eta *= bs.eta;
         let wo = s.to_world(bs.wo);
-        ray = s.spawn_ray(wo);
         let non_null = bs.sampled_type & flags::NULL == 0;
+        if non_null {
+            tally.surface_vertex(&s, ray.d, bs.sampled_type & flags::TRANSMISSION != 0);
+        }
+        ray = s.spawn_ray(wo);
         weight.bsdf_sampled(&bs, bsdf_weight, non_null);
         if let Some(snee) = &mut snee {
             snee.after_bsdf(scene, &s, &bs, wo);

@@ -43,8 +43,7 @@
 //! volpathmis loses ~40 % of the red channel on our test scene (σt,blue = 1e-30 gives the limit)
 //! and its volpath returns NaN; we do not reproduce that.
 
-use super::manifold::ManifoldStage;
-use super::snee::SneeStage;
+use super::classes::{NoClasses, Tally};
 use super::stats::LocalStats;
 use super::volpath::{trace, Cx, EmitterHit, PathWeight};
 use super::walk::{shadow_ray, walk_segments, PathSetup, RefPoint};
@@ -218,8 +217,21 @@ pub fn li_with(
     stats: &mut LocalStats,
     roulette: RouletteMis,
 ) -> (Spectrum, bool) {
+    li_tally(scene, sampler, ray, medium, stats, roulette, &mut NoClasses)
+}
+
+/// [`li_with`], also adding every contribution to `tally` (transport classes, `classes.rs`).
+pub fn li_tally<T: Tally>(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    ray: Ray,
+    medium: Option<u32>,
+    stats: &mut LocalStats,
+    roulette: RouletteMis,
+    tally: &mut T,
+) -> (Spectrum, bool) {
     let weight = SpectralMis { p_over_f: POverF::ONE, p_over_f_nee: POverF::ONE, roulette };
-    trace(scene, sampler, ray, medium, stats, weight, None)
+    trace(scene, sampler, ray, medium, stats, weight, None, tally)
 }
 
 /// volpathmis's path weight: the forward (BSDF / phase sampling) and light-sampling densities over
@@ -263,16 +275,9 @@ impl PathWeight for SpectralMis {
     }
 
     #[inline]
-    fn medium_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        m: &Homogeneous,
-        p: Vec3,
-        wi: Vec3,
-        medium: Option<u32>,
-    ) -> Spectrum {
-        let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
-
+    fn medium_emitter_sampling(&mut self, cx: &mut Cx, m: &Homogeneous, p: Vec3, wi: Vec3) -> Spectrum {
+        let (scene, channel, medium) = (cx.scene, cx.channel, cx.medium);
+        let (sampler, stats) = (&mut *cx.sampler, &mut *cx.stats);
         let mut c = Spectrum::ZERO;
         if m.sample_emitters {
             let (mut nee_end, mut uni_end, emitted, ds) =
@@ -296,18 +301,9 @@ impl PathWeight for SpectralMis {
     }
 
     #[inline]
-    fn emitter_hit(
-        &mut self,
-        cx: &mut Cx,
-        hit: &EmitterHit,
-        _ray_d: Vec3,
-        count_direct: bool,
-        _snee: Option<&SneeStage>,
-        _manifold: Option<&ManifoldStage>,
-    ) -> Spectrum {
+    fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit) -> Spectrum {
         let scene = cx.scene;
-
-        let w = if count_direct {
+        let w = if hit.count_direct {
             self.p_over_f.weight()
         } else {
             let emitter_pdf = scene.pdf_emitter_direction(hit.from, &hit.ds);
@@ -318,25 +314,18 @@ impl PathWeight for SpectralMis {
     }
 
     #[inline]
-    fn surface_emitter_sampling(
-        &mut self,
-        cx: &mut Cx,
-        s: &SurfaceInteraction,
-        bsdf: &Bsdf,
-        medium: Option<u32>,
-        _snee: Option<&SneeStage>,
-    ) -> Spectrum {
-        let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
-
+    fn surface_emitter_sampling(&mut self, cx: &mut Cx, s: &SurfaceInteraction, bsdf: &Bsdf) -> (Spectrum, Vec3) {
+        let (scene, channel, medium) = (cx.scene, cx.channel, cx.medium);
+        let (sampler, stats) = (&mut *cx.sampler, &mut *cx.stats);
         let (mut nee_end, mut uni_end, emitted, ds) =
             sample_emitter(scene, RefPoint::Surface(s), medium, &self.p_over_f, channel, sampler, stats);
         if emitted == Spectrum::ZERO {
-            return Spectrum::ZERO;
+            return (Spectrum::ZERO, ds.d);
         }
         let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&BsdfContext::default(), s, s.to_local(ds.d));
         nee_end.update(Spectrum::ONE, bsdf_val);
         uni_end.update(Vec3::splat(if ds.delta { 0.0 } else { bsdf_pdf }), bsdf_val);
-        nee_end.weight_with(&uni_end) * emitted
+        (nee_end.weight_with(&uni_end) * emitted, ds.d)
     }
 
     #[inline]
