@@ -324,6 +324,18 @@ def zscore(mu, se, ref_mu, ref_se):
     return (mu - ref_mu) / den if den > 0 else (0.0 if mu == ref_mu else math.copysign(math.inf, mu - ref_mu))
 
 
+def class_shares(ch, n, denom):
+    """Per transport class (channels CLASS.R/G/B, CLASS.m2.R/G/B of a --classes --moment render of n
+    spp): its share V_class / V of the per-sample relative variance, and the classes' sum against
+    the image (max relative difference)."""
+    names = sorted({c[:-2] for c in ch if c.endswith(".R") and not c.startswith("m2.") and ".m2." not in c})
+    v_total = float(np.mean(moment_var(ch, n) / denom))
+    img = rgb_of(ch)
+    total = sum(rgb_of(ch, c + ".") for c in names)
+    return {"V": v_total, "sum_max_rel_diff": float(np.max(np.abs(total - img)) / max(np.max(np.abs(img)), 1e-30)),
+            "share": {c: safe_div(float(np.mean(moment_var(ch, n, c + ".") / denom)), v_total) for c in names}}
+
+
 def safe_div(a, b):
     """a / b with x / 0 = inf (x > 0), 0 / 0 = nan, inf / inf = nan."""
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -491,13 +503,7 @@ def run_config(args, P, work, name):
         for m in ("volpath", "snee"):
             ch, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.classes", seed=400,
                                  spp=spp[m], extra=["--moment", "--classes"])
-            names = sorted({c[:-2] for c in ch if c.endswith(".R") and not c.startswith("m2.") and ".m2." not in c})
-            v_total = float(np.mean(moment_var(ch, st["spp"]) / denom))
-            total = sum(rgb_of(ch, c + ".") for c in names)
-            img = rgb_of(ch)
-            classes[m] = {"V": v_total, "sum_max_rel_diff": float(np.max(np.abs(total - img)) / max(np.max(np.abs(img)), 1e-30)),
-                          "share": {c: float(np.mean(moment_var(ch, st["spp"], c + ".") / denom)) / max(v_total, 1e-300)
-                                    for c in names}}
+            classes[m] = class_shares(ch, st["spp"], denom)
     if mit is not None:
         mit.close()
 
@@ -760,6 +766,16 @@ def report(args, P, mode, work, names, results, total, load):
         text += ["Transport classes: this snee binary has no `--classes`; not measured.", ""]
     with open(os.path.join(out, "study.md"), "w") as fh:
         fh.write("\n".join(text))
+    readme = os.path.join(out, "README.md")  # figures/README.md carries the same table between markers
+    if os.path.exists(readme):
+        body = open(readme).read()
+        begin, end = "<!-- study table: written by scripts/reproduce_figures.py", "<!-- /study table -->"
+        i, j = body.find(begin), body.find(end)
+        if 0 <= i < j:
+            i = body.index("\n", i) + 1
+            body = body[:i] + "\n".join(text[2:]) + "\n" + body[j:]
+            with open(readme, "w") as fh:
+                fh.write(body)
     common.write_json_atomic(os.path.join(out, "study.json"), finite(
         {"mode": mode, "params": P, "threads": args.threads, "z_threshold_sidak": zcrit, "alpha": ALPHA,
          "wall_seconds": total, "load_average": load, "mitsuba": mi_note, "results": results}))
