@@ -454,12 +454,28 @@ def run_config(args, P, work, name):
                             seconds=P["run_time"])
         spp[m] = max(2, int(round(st["spp"] / st["seconds"] * P["run_time"])))
     if mit is not None:
-        pr = mit.call({"cmd": "probe", "seconds": P["run_time"]})
-        if pr is not None:
-            spp["mitsuba"] = max(2, int(round(pr["rate"] * P["run_time"])))
-            mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 3, "out": None})  # warm-up: compiles
-            mstat = {"variant": mit.info["variant"], "notes": mit.info["notes"], "probe": pr,
-                     "load_seconds": mit.info["load_seconds"], "thread_count": mit.info["thread_count"]}
+        rdir = os.path.join(work, "renders")
+        setup_json = os.path.join(rdir, f"{name}.mitsuba.setup.json")
+        cached = not args.force_renders and os.path.exists(os.path.join(rdir, f"{name}.mitsuba.firefly.npy")) and all(
+            os.path.exists(os.path.join(rdir, f"{name}.mitsuba.run{i}.{x}")) for i in range(P["runs"]) for x in ("json", "npy"))
+        if cached:  # the runs exist: no worker, no probe
+            if os.path.exists(setup_json):
+                with open(setup_json) as fh:
+                    mstat = json.load(fh)
+            elif os.path.exists(res_path):  # written before set-up files existed: the earlier result has it
+                with open(res_path) as fh:
+                    mstat = json.load(fh).get("mitsuba", {})
+            with open(os.path.join(rdir, f"{name}.mitsuba.run0.json")) as fh:
+                spp["mitsuba"] = json.load(fh)["spp"]
+        else:
+            pr = mit.call({"cmd": "probe", "seconds": P["run_time"]})
+            if pr is not None:
+                spp["mitsuba"] = max(2, int(round(pr["rate"] * P["run_time"])))
+                mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 3, "out": None})  # warm-up: compiles
+                mstat = {"variant": mit.info["variant"], "notes": mit.info["notes"], "probe": pr,
+                         "load_seconds": mit.info["load_seconds"], "thread_count": mit.info["thread_count"]}
+                os.makedirs(rdir, exist_ok=True)
+                common.write_json_atomic(setup_json, mstat)
     for i in range(P["runs"]):
         for m in ("volpath", "snee"):
             ch, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.run{i}",
@@ -519,8 +535,15 @@ def run_config(args, P, work, name):
         run_means = X.mean(axis=(1, 2, 3))
         spread = (X.var(axis=0, ddof=1) / denom).reshape(-1)  # per pixel-channel s^2 / denom
 
-        def v_spread(idx, X=X, n=n):
-            return n * float(np.mean(X[idx].var(axis=0, ddof=1) / denom)) * N / (N - 1)
+        # Bootstrap of the spread estimate through the runs' Gram matrix G_ij = mean_p x_ip x_jp / denom_p:
+        # for weights w_i = count_i / N, the ddof-1 variance averaged over pixels is
+        # N / (N - 1) (sum_i w_i G_ii - w^T G w); times N / (N - 1) for the bootstrap's bias.
+        xd = (X / np.sqrt(denom)).reshape(N, -1)
+        gram = xd @ xd.T / xd.shape[1]
+
+        def v_spread(idx, gram=gram, n=n):
+            w = np.bincount(idx, minlength=N) / N
+            return n * float(w @ np.diag(gram) - w @ gram @ w) * (N / (N - 1)) ** 2
         s = {"spp": n, "t": t.tolist(), "c": float(t.sum() / (N * n)), "run_means": run_means.tolist(),
              "V_spread": n * float(spread.mean())}
         if m != "mitsuba":
@@ -533,8 +556,18 @@ def run_config(args, P, work, name):
         s["efficiency"] = safe_div(1.0, s["V"] * s["c"])
         a = X.mean(axis=0)
         avg[m] = a
-        mu, se = float(run_means.mean()), float(run_means.std(ddof=1) / math.sqrt(N))
-        s.update(mean=mu, se=se, z=zscore(mu, se, ref["mean"], ref["se"]),
+        mu = float(run_means.mean())
+        if m != "mitsuba":  # standard error of the mean of all N n samples per pixel (moments)
+            _, se = mean_se_bound(a, np.mean([r["var"] for r in rs], axis=0), N * n)
+            z = zscore(mu, se, ref["mean"], ref["se"])
+        else:  # only the N runs' means: a t statistic with N - 1 degrees of freedom, as the equivalent z
+            from scipy.stats import norm
+            from scipy.stats import t as student_t
+            se = float(run_means.std(ddof=1) / math.sqrt(N))
+            tstat = zscore(mu, se, ref["mean"], ref["se"])
+            s["t_stat"] = tstat
+            z = math.copysign(float(norm.isf(student_t.sf(abs(tstat), N - 1))), tstat) if math.isfinite(tstat) else tstat
+        s.update(mean=mu, se=se, z=z,
                  relmse=None if ref["image"] is None else common.rel_mse(a, ref["image"], denom),
                  relmse_k={} if ref["image"] is None else
                  {str(kk): common.rel_mse(X[:kk].mean(axis=0), ref["image"], denom) for kk in (1, 2, 4, 8) if kk <= N},
