@@ -7,8 +7,9 @@ sky) rendered by snee's volpath_snee (connection = complete) next to Mitsuba 3's
 snee renders the scene as written (`--time SECONDS`, time from --stats, scene loading excluded).
 Mitsuba loads the same XML with the <integrator> element swapped for its `volpath` (same max_depth;
 Mitsuba has no volpath_snee); after an untimed 1-spp warm-up and a timed probe for its rate, it renders
-spp = rate x snee's measured seconds in one call, timed as wall clock around mi.render minus drjit's LLVM
-compile time. Both with the same thread count. Outputs figures/first.png (left: snee, right: Mitsuba,
+spp = rate x snee's measured seconds, timed as wall clock around mi.render minus drjit's LLVM
+compile time, in passes at the rate measured so far until its time reaches snee's. Both with the same
+thread count. Outputs figures/first.png (left: snee, right: Mitsuba,
 the same exposure) and figures/first.json (spp, seconds, image means; the means differ because
 volpath cannot connect to the sun through the smooth glass: the medium is lit by the sky and the sunlit floor
 only). Neither renders the unscattered sun refracted through the cube onto the floor (a caustic; the cube's
@@ -64,9 +65,16 @@ def render_mitsuba(seconds, threads, seed):
     while t < seconds / 8 and spp < 1 << 16:  # probe: doubling until an eighth of the budget
         spp *= 2
         _, t = run(spp, 2)
-    n = max(1, int(round(spp / t * seconds)))
-    img, t = run(n, seed)
-    return img, {"spp": n, "seconds": t, "variant": variant, "notes": notes, "mitsuba_version": mi.__version__}
+    # Passes (each at the rate measured so far) until Mitsuba has rendered as long as snee did.
+    rate, acc, n, total, k = spp / t, None, 0, 0.0, 0
+    while total < 0.98 * seconds and k < 20:
+        m = max(1, int(round(rate * (seconds - total))))
+        img, t = run(m, seed + 1000 * k)
+        acc = img * m if acc is None else acc + img * m
+        n, total, k = n + m, total + t, k + 1
+        rate = n / total
+    return acc / n, {"spp": n, "seconds": total, "passes": k, "variant": variant, "notes": notes,
+                     "mitsuba_version": mi.__version__}
 
 
 def main():
