@@ -77,6 +77,7 @@ Sizes:
               per task, firefly renders at 16x resolution; each configuration is one Ray task
               (`ray.init()` here by default, --address to join a cluster started with `ray start`;
               --work must then be a folder every node sees). Outputs in figures/paper_size/.
+  --smoke     seconds per configuration, to check the pipeline (also with --ray); its numbers mean nothing.
 
 Outputs (--out): study.md (the table), study.json (everything), study_error_vs_time.png,
 paper_fig3.png, paper_fig4.png, paper_fig4_mitsuba.png.
@@ -802,12 +803,14 @@ def report(args, P, mode, work, names, results, total, load):
                f"{min(loads, default=0):.1f}-{max(loads, default=0):.1f} (2 cores shared with other jobs); {mi_note}.")
     verdicts = []
     for other, label in (("volpath", "snee volpath"), ("mitsuba", "Mitsuba volpath")):
-        q = [results[n]["ratios"].get(other) for n in names]
+        black = [n for n in names if results[n]["methods"].get(other, {}).get("mean") == 0.0]
+        q = [results[n]["ratios"].get(other) for n in names if n not in black]
         q = [x for x in q if x and x.get("lo") is not None and x.get("hi") is not None]
         win = sum(1 for x in q if x["lo"] > 1)
         lose = sum(1 for x in q if x["hi"] < 1)
         verdicts.append(f"volpath_snee vs {label}: more efficient (95 % interval above 1) in {win}, less efficient "
-                        f"(below 1) in {lose}, undecided in {len(q) - win - lose} of {len(q)} configurations")
+                        f"(below 1) in {lose}, undecided in {len(q) - win - lose} of {len(q)} configurations where "
+                        f"both render the transport (in {len(black)} more, {label} renders black)")
     summary += " " + "; ".join(verdicts) + "."
     cls_lines = []
     for name in names:
