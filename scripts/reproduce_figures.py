@@ -1,80 +1,87 @@
 #!/usr/bin/env python3
-"""Reproduce Koerner et al. 2016, Section 6 (Figures 3 and 4) with snee, beside Mitsuba 3's volpath.
+"""The equal-time study of volpath_snee (Koerner et al. 2016, Section 6, Figures 3 and 4) against snee's
+volpath and Mitsuba 3's volpath, on the 18 configurations of scenes/paper/ (written by
+scripts/make_figure_assets.py): light in {envmap, sphere (0.006 sr), directional}, boundary in {ggx020,
+ggx004, smooth}, extinction in {st02 (2 /m), st34 (34 /m)}; medium albedo 0.8, isotropic.
 
-The 18 configurations are scenes/paper/{light}_{boundary}_{extinction}.xml (written by
-scripts/make_figure_assets.py): light in {envmap, sphere (0.006 sr), directional}, boundary in
-{ggx020, ggx004, smooth}, extinction in {st02 (2 /m), st34 (34 /m)}; medium albedo 0.8, isotropic.
+    python3 scripts/reproduce_figures.py --standard     # <= 60 min on 2 cores; outputs in figures/
+    python3 scripts/reproduce_figures.py --paper [--address auto]   # Ray cluster; figures/paper_size/
 
-For every configuration it renders with ./target/release/snee (one render at a time, --threads T):
+Per configuration (one after the other; cached per render and per configuration in --work, so an
+interrupted run resumes where it stopped; --force renders again):
 
-  Figure 3  equal samples, transport = snee (only the suffixes SNEE can make): left half
-            volpath_snee with snee = forward (= volpath restricted to that transport), right half
-            volpath_snee with snee = mis; FIG3_SPP samples per pixel each.
-  Figure 4  equal time, all transport: left half `volpath`, right half `volpath_snee` (snee = mis).
-            Each method renders len(SERIES) independent runs (seeds differ): the first with
-            --time SERIES[0] (a timed probe; snee's --time stops between passes of doubling size,
-            so it can overshoot), the others with --spp chosen from the measured samples/second so
-            that the cumulative render time tracks cumsum(SERIES) (e.g. 0.5, 1, 2, 4 s). The
-            spp-weighted running averages are the estimates at those times; the last one is the
-            equal-time image of Figure 4.
-  Mitsuba   Mitsuba 3's `volpath` on the same XML file, unchanged (its default integrator=volpath),
-            at equal time: paper_fig4_mitsuba.png has Figure 4's layout with Mitsuba volpath in
-            the left halves and snee volpath_snee (the same images as in Figure 4) in the right.
-            It runs in a subprocess per configuration (this script with --mitsuba-worker), so a
-            missing package or a crash only marks Mitsuba's columns "not run" / "failed".
-            Variant llvm_ad_rgb (libLLVM from DRJIT_LIBLLVM_PATH or a few standard paths), else
-            scalar_rgb; the variant used is printed and recorded. Thread count: drjit's
-            dr.set_thread_count(T), the same T as snee's, set after loading the scene (Mitsuba
-            3.9.1 deadlocks loading the envmap scenes with a 1-thread pool; loading is untimed).
-            Mitsuba has no time budget, so after loading the scene it renders 1 spp untimed
-            (warm-up: JIT compilation, first-use setup), then a timed probe of MI_PROBE_SPP spp
-            (not used in the estimates) gives the rate for the first run's spp (SERIES[0] x rate);
-            later runs take spp from the rate measured so far, exactly as for snee. Seeds differ
-            per run and per pass. Each run is rendered with Mitsuba's `moment` integrator around
-            volpath (the same samples as plain volpath, plus second moments, as snee's --moment),
-            in passes of at most 2^22 samples.
-            What is timed: wall clock (perf_counter) around mi.render(...) of every pass and the
-            copy of the developed image to numpy, MINUS the LLVM backend compilation time of the
-            kernels those calls compiled (drjit's kernel history, `backend_time`; llvm kernels are
-            recompiled when spp changes, and cached on disk by drjit). Excluded: Python start-up,
-            scene loading, the warm-up and the probe, compilation. Tracing (codegen) and
-            execution are included. The CPU time of the process is recorded too, as a check.
-  reference volpath_snee (snee = mis, all transport), two independent halves of REF_TIME seconds
-            each, averaged. It is a long SNEE render, not a method-independent ground truth: no
-            path tracer converges for a directional light behind a smooth boundary. Its own noise
-            is estimated from the two halves: floor = relMSE(half A, half B) / 4 (the relMSE a
-            perfect estimate would show against this reference).
+Reference (never produced by a compared method's runs):
+  * wherever volpath converges (every configuration except directional + smooth): snee `volpath`,
+    REF_PARTS independent renders (distinct seeds) of REF_FACTOR * RUN_TIME / REF_PARTS seconds each,
+    so the reference gets REF_FACTOR (100) times one run's budget. Reference = spp-weighted mean.
+  * directional + smooth (volpath cannot sample a delta light through a delta boundary): the same
+    scene with the directional light replaced by a sphere light of solid angle Omega in the same
+    direction at 1 km with the same irradiance (radiance E / (pi sin^2 alpha)), rendered with
+    `volpath` for each Omega in OMEGAS (the budget split evenly), and the image mean extrapolated
+    linearly in Omega to Omega = 0 (weighted least squares). Its error: the intercept's standard
+    error, and the fit's chi^2 (1 degree of freedom with 3 radii) as a check of the linear model.
+    (`volpath_snee connection=complete` would be exact here only for flat boundaries; the statue is
+    curved.)
+  * d, the per-pixel denominator of relative errors: the per-pixel, per-channel MEDIAN of the
+    reference's independent parts (all radii for directional + smooth): robust to fireflies and
+    independent of the runs. Denominator d^2 + eps with eps = 1e-2 * (mean of d)^2.
+  * the reference's own error: standard error of its image mean (per-pixel moments; channels
+    bounded as fully correlated), and its own relative variance RV_ref = mean(var / (d^2 + eps)).
 
-relMSE is snee's (`snee compare`): mean over pixels and channels of (a - ref)^2 / (ref^2 + 1e-2), for
-all three methods against the same reference. Times are render seconds (snee: from the stats JSON,
-scene loading excluded; Mitsuba: as above), wall-clock on a shared machine. For each configuration
-and method it fits relMSE = c * t^s over the series, reports the time to reach relMSE = TARGET
-((TARGET/c)^(1/s) with the fitted slope; "never" when the error does not decrease, s > -0.5), the
-relMSE at the equal time, and SNEE's efficiency ratio
-  eff = (relMSE_volpath * t_volpath) / (relMSE_snee * t_snee)  (= efficiency 1/(relMSE t) of
-volpath_snee over volpath's; > 1: SNEE wins), also with the reference floor subtracted, and the
-same ratio against Mitsuba's volpath, plus t_target(Mitsuba) / t_target(volpath_snee).
-It also checks consistency: z-scores of each image's mean against the reference's (standard
-errors from the per-pixel second moments; for Mitsuba on luminance Y, because its `moment`
-integrator records second moments in XYZ; the reference's Y standard error is then bounded by
-assuming fully correlated channels), and, for Figure 3, snee = forward against snee = mis (both
-estimate the same integral).
+Runs (interleaved: volpath, volpath_snee, Mitsuba, volpath, ... so all see the same machine load):
+  each method first renders one probe of RUN_TIME seconds (not used) to measure its rate, then RUNS
+  (8) independent runs with distinct seeds at the FIXED spp n = rate * RUN_TIME. snee: --moment,
+  time t from --stats (scene loading excluded). Mitsuba: a persistent worker process (this script
+  with --mitsuba-worker) that loaded the unchanged XML once (default integrator volpath); t is the
+  wall clock around mi.render minus drjit's LLVM compile time; one untimed warm-up at n compiles
+  the kernel first. Variant llvm_ad_rgb (else scalar_rgb), dr.set_thread_count(THREADS).
 
-Outputs (in --out, default figures/): paper_fig3.png, paper_fig4.png, paper_fig4_mitsuba.png,
-paper_relmse_vs_time.png, paper_results.md (the table, as printed), paper_results.json. Renders
-are cached in --work (default target/paper_figures/<mode>): delete it or pass --force to render again.
+Efficiency (per method): V = per-sample relative variance = mean over pixels and channels of
+sigma^2_p / (d_p^2 + eps); c = seconds per sample per pixel = sum t / (RUNS n); a render of time t has
+relative variance RV(t) = V c / t, so efficiency = 1 / (RV t) = 1 / (V c).
+  * snee methods, V from moments: per run, sigma^2_p = (m2_p - x_p^2) n / (n - 1) (m2 is the
+    per-pixel mean of the squared samples, src/render.rs; unbiased per run); V = mean over runs.
+  * Mitsuba (no per-pixel moments in RGB), V from the spread of the runs: with s^2_p the sample
+    variance (ddof 1) of pixel p over the RUNS runs, E[s^2_p] = sigma^2_p / n, so
+    V = n * mean(s^2_p / (d^2 + eps)): the same quantity. snee's methods get this estimate too
+    (JSON: V_spread), a check of the moment estimate.
+  * Ratios volpath_snee / volpath and volpath_snee / Mitsuba volpath, with a 95 % percentile
+    bootstrap over runs (run indices resampled jointly for all methods: interleaved runs share the
+    load); a resampled spread estimate is multiplied by RUNS / (RUNS - 1) (the bootstrap's bias
+    of a ddof-1 variance).
+  * A ratio where the compared method fails the bias test measures the variance of an estimate of
+    a different integral (volpath under directional + smooth is black): flagged in the table.
+Bias: image mean (pixels and channels) of the RUNS-run average against the reference; standard
+  error from the spread of the runs' means (so channel correlations count, also for Mitsuba), plus
+  the reference's; |z| judged at the Sidak threshold for family-wise 1 % over all tests.
+Firefly rate: each method renders the scene once at FIREFLY_SCALE times the width and height with
+  1 spp (box filter: each pixel is one sample, distributed over the film as the samples of the
+  normal render); rate = samples per 10^6 whose luminance exceeds 100 x the reference image's mean
+  luminance.
+relMSE (secondary): mean of (average of the runs - reference)^2 / (d^2 + eps); its expectation is
+  RV(average) + RV_ref + bias^2, both RVs in the JSON.
+Transport classes: when `snee render --help` lists --classes, one more untimed run per snee method
+  at n spp with --classes --moment: each class's share of V (V_class / V, from the same samples;
+  shares need not sum to 1: a sample can contribute to several classes), and the classes' sum
+  against the image (max relative difference).
+Figure 3: equal samples (FIG3_SPP), transport = snee: volpath_snee snee = forward (left halves)
+  against snee = mis with snee_rate = 1 (right halves); z of the image means.
+Figure 4: the average of the RUNS runs (equal time) of volpath | volpath_snee, and Mitsuba | snee.
+`volpath_snee connection=complete` is not run: on the curved statue it renders exactly what the
+  default `paper` connection renders (it applies to flat boundaries only; docs/manifold.md).
 
-Modes:
-  --quick   FIG3_SPP = 32, SERIES = 0.5 0.5 1 2 s (cumulative 0.5..4 s), REF_TIME = 2 x 8 s.
-            About 10-12 minutes with --threads 1 (~33 s per configuration, of which Mitsuba ~6 s).
-  (full)    FIG3_SPP = 500 (the paper's), SERIES = 4 4 8 16 s (cumulative 4..32 s, the paper
-            uses 30 s), REF_TIME = 2 x 300 s: about 4.7 hours with --threads 1.
+Sizes:
+  --standard  RUN_TIME 0.5 s x 8 runs, reference 100 x 0.5 s = 50 s (4 parts), FIG3_SPP 32, 2 threads,
+              firefly renders at 6x resolution. Outputs committed in figures/.
+  --paper     RUN_TIME 30 s x 8 runs, reference 3000 s (10 parts), FIG3_SPP 500 (the paper's), 1 thread
+              per task, firefly renders at 16x resolution; each configuration is one Ray task
+              (`ray.init()` here by default, --address to join a cluster started with `ray start`;
+              --work must then be a folder every node sees). Outputs in figures/paper_size/.
+  --smoke     seconds per configuration, to check the pipeline (also with --ray); its numbers mean nothing.
 
-Requires: cargo build --release; pip install -r scripts/requirements.txt (numpy, matplotlib;
-mitsuba only for the Mitsuba columns: --no-mitsuba skips them).
-
-Usage:  python3 scripts/reproduce_figures.py [--quick] [--threads 1] [--only PATTERN] [--force]
-                                            [--no-mitsuba] [--mitsuba-variant auto|llvm_ad_rgb|scalar_rgb]
+Outputs (--out): study.md (the table), study.json (everything), study_error_vs_time.png,
+paper_fig3.png, paper_fig4.png, paper_fig4_mitsuba.png.
+Requires: cargo build --release; pip install -r scripts/requirements.txt; Ray for --paper.
 """
 import argparse
 import fnmatch
@@ -82,13 +89,15 @@ import json
 import math
 import os
 import re
-import struct
 import subprocess
 import sys
 import time
-import zlib
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import common  # noqa: E402
+from common import read_exr, rgb_of  # noqa: E402,F401  (read_exr: also imported by roughness_sweep.py)
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 SCENES = os.path.join(ROOT, "scenes", "paper")
@@ -99,370 +108,545 @@ EXTINCTIONS = ["st02", "st34"]
 LABEL = {"envmap": "envmap", "sphere": "sphere 0.006 sr", "directional": "directional",
          "ggx020": "GGX 0.2", "ggx004": "GGX 0.04", "smooth": "smooth",
          "st02": "sigma_t 2/m", "st34": "sigma_t 34/m"}
-TARGET = 0.01  # relMSE the "time to reach" column refers to
 MODES = {
-    "quick": {"fig3_spp": 32, "series": [0.5, 0.5, 1.0, 2.0], "ref_time": 8.0},
-    "full": {"fig3_spp": 500, "series": [4.0, 4.0, 8.0, 16.0], "ref_time": 300.0},
+    "standard": {"fig3_spp": 32, "run_time": 0.5, "runs": 8, "ref_factor": 100, "ref_parts": 4,
+                 "omegas": [0.006, 0.003, 0.0015], "firefly_scale": 6, "threads": 2, "boot": 2000},
+    "paper": {"fig3_spp": 500, "run_time": 30.0, "runs": 8, "ref_factor": 100, "ref_parts": 10,
+              "omegas": [0.006, 0.003, 0.0015], "firefly_scale": 16, "threads": 1, "boot": 4000},
+    # --smoke: a check that the pipeline runs (seconds per configuration); its numbers mean nothing.
+    "smoke": {"fig3_spp": 4, "run_time": 0.1, "runs": 3, "ref_factor": 10, "ref_parts": 2,
+              "omegas": [0.006, 0.003, 0.0015], "firefly_scale": 2, "threads": 2, "boot": 200},
 }
-# Mitsuba: libLLVM candidates for llvm_ad_rgb (Debian's libllvm19 first), probe size, pass size.
-MI_LLVM_CANDIDATES = ["/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so",
-                      "/usr/lib/x86_64-linux-gnu/libLLVM-18.so", "/usr/lib/x86_64-linux-gnu/libLLVM-17.so",
-                      "/usr/lib/x86_64-linux-gnu/libLLVM-16.so", "/usr/lib/x86_64-linux-gnu/libLLVM-15.so",
-                      "/usr/lib/x86_64-linux-gnu/libLLVM-14.so"]
-MI_PROBE_SPP = 8
-MI_MAX_SAMPLES_PER_PASS = 1 << 22
-MI_NOT_INSTALLED = 3  # the worker's exit code when `import mitsuba` fails
-Y_WEIGHTS = np.array([0.212671, 0.715160, 0.072169])  # row Y of Mitsuba's sRGB -> XYZ matrix
+SPHERE_DISTANCE = 1000.0  # m: the irradiance varies by +-0.1 % over the 1 m statue
+FIREFLY_FACTOR = 100.0
+ALPHA = 0.01  # family-wise level of the bias tests
+LUM = np.array([0.212671, 0.715160, 0.072169])
+MI_NOT_INSTALLED = 3
+RENDERED = [0]  # renders this process ran (a re-analysis of cached renders keeps the first run's times)
 # snee's integrator variants: name -> (integrator type, extra XML properties)
 VARIANTS = {
     "volpath": ("volpath", ""),
     "snee": ("volpath_snee", ""),
     "fig3_forward": ("volpath_snee", '<string name="snee" value="forward"/><string name="transport" value="snee"/>'),
-    # Figure 3 compares the techniques at equal samples: SNEE at every vertex (snee_rate = 1).
     "fig3_snee": ("volpath_snee", '<string name="snee" value="mis"/><string name="transport" value="snee"/>'
                   '<float name="snee_rate" value="1"/>'),
 }
+METHODS = [  # key, label, plot style
+    ("volpath", "snee volpath", dict(color="C0", marker="o")),
+    ("snee", "snee volpath_snee", dict(color="C1", marker="s")),
+    ("mitsuba", "Mitsuba volpath", dict(color="C2", marker="^")),
+]
 
 
 def configs():
     return [f"{l}_{b}_{e}" for e in EXTINCTIONS for l in LIGHTS for b in BOUNDARIES]
 
 
-# ----------------------------------------------------------------------------- rendering
+# ----------------------------------------------------------------------------- scenes and renders
 
-def variant_xml(work, config, variant):
-    """A copy of the configuration with the variant's integrator (asset paths made absolute)."""
-    itype, extra = VARIANTS[variant]
+def scene_text(config):
     text = open(os.path.join(SCENES, config + ".xml")).read()
     text = text.replace('value="statue.ply"', f'value="{os.path.join(SCENES, "statue.ply")}"')
-    text = text.replace('value="sun_sky.exr"', f'value="{os.path.join(SCENES, "sun_sky.exr")}"')
-    text, n = re.subn(r'<integrator type="\$integrator">',
-                      f'<integrator type="{itype}">{extra}', text)
+    return text.replace('value="sun_sky.exr"', f'value="{os.path.join(SCENES, "sun_sky.exr")}"')
+
+
+def with_sphere_light(text, omega):
+    """The directional light replaced by a sphere light of solid angle omega, same direction and
+    irradiance (pi L sin^2 alpha = E on a plane facing it), at SPHERE_DISTANCE."""
+    m = re.search(r'<emitter type="directional">.*?</emitter>', text, re.S)
+    d = np.array([float(v) for v in re.search(r'x="([^"]+)" y="([^"]+)" z="([^"]+)"', m.group(0)).groups()])
+    e = np.array([float(v) for v in re.search(r'name="irradiance" value="([^"]+)"', m.group(0)).group(1).split(",")])
+    d /= np.linalg.norm(d)
+    cos_a = 1.0 - omega / (2.0 * math.pi)
+    sin_a = math.sqrt(1.0 - cos_a * cos_a)
+    c = -d * SPHERE_DISTANCE
+    radiance = e / (math.pi * sin_a * sin_a)
+    sphere = (f'<shape type="sphere"><point name="center" x="{c[0]:.6f}" y="{c[1]:.6f}" z="{c[2]:.6f}"/>'
+              f'<float name="radius" value="{SPHERE_DISTANCE * sin_a:.6f}"/><emitter type="area">'
+              f'<rgb name="radiance" value="{radiance[0]:.6f}, {radiance[1]:.6f}, {radiance[2]:.6f}"/>'
+              f'</emitter></shape>')
+    return text[:m.start()] + sphere + text[m.end():]
+
+
+def variant_xml(work, config, variant, omega=None):
+    """A copy of the configuration with the variant's integrator (and, with omega, the sphere light)."""
+    itype, extra = VARIANTS[variant]
+    text = scene_text(config)
+    if omega is not None:
+        text = with_sphere_light(text, omega)
+    text, n = re.subn(r'<integrator type="\$integrator">', f'<integrator type="{itype}">{extra}', text)
     assert n == 1, config
-    path = os.path.join(work, "xml", f"{config}.{variant}.xml")
+    tag = f"{config}.{variant}" + (f".omega{omega:g}" if omega is not None else "")
+    path = os.path.join(work, "xml", tag + ".xml")
     os.makedirs(os.path.dirname(path), exist_ok=True)
-    with open(path, "w") as fh:
-        fh.write(text)
+    if not os.path.exists(path) or open(path).read() != text:
+        with open(path, "w") as fh:
+            fh.write(text)
     return path
 
 
-def render(args, work, config, variant, tag, seed, spp=None, seconds=None):
-    """Render once (cached); returns (rgb, m2, stats)."""
-    out = os.path.join(work, "renders", f"{config}.{variant}.{tag}.exr")
+def snee_render(args, work, xml, tag, seed, spp=None, seconds=None, extra=()):
+    """One snee render (cached in WORK/renders/TAG.exr + .json); returns (channels, stats)."""
+    out = os.path.join(work, "renders", tag + ".exr")
     stats = out[:-4] + ".json"
-    if args.force or not (os.path.exists(out) and os.path.exists(stats)):
+    if args.force_renders or not (os.path.exists(out) and os.path.exists(stats)):
+        RENDERED[0] += 1
         os.makedirs(os.path.dirname(out), exist_ok=True)
-        cmd = [SNEE, "render", variant_xml(work, config, variant), "-o", out, "--seed", str(seed),
-               "--threads", str(args.threads), "--stats", stats, "-q", "--moment"]
+        cmd = [SNEE, "render", xml, "-o", out, "--seed", str(seed), "--threads", str(args.threads),
+               "--stats", stats, "-q", *extra]
         cmd += ["--spp", str(spp)] if spp is not None else ["--time", str(seconds)]
         subprocess.run(cmd, check=True)
-    ch = read_exr(out)
-    rgb = np.stack([ch[c] for c in ("R", "G", "B")], axis=-1).astype(np.float64)
-    m2 = np.stack([ch[c] for c in ("m2.R", "m2.G", "m2.B")], axis=-1).astype(np.float64)
     with open(stats) as fh:
-        st = json.load(fh)
-    return rgb, m2, st
+        return read_exr(out), json.load(fh)
 
 
-def read_exr(path):
-    """Minimal OpenEXR reader (numpy + zlib) for snee's output, so that the snee part needs no
-    `mitsuba` package: single part, scan lines or one-level tiles, compression none / ZIPS / ZIP,
-    half or float channels. Returns {channel name: (H, W) float32 array}."""
-    with open(path, "rb") as fh:
-        buf = fh.read()
-    magic, version = struct.unpack_from("<ii", buf, 0)
-    if magic != 20000630 or version & 0x1800:
-        raise ValueError(f"{path}: not a single-part, flat OpenEXR file")
-    tiled = bool(version & 0x200)
-    pos, attrs = 8, {}
-    while buf[pos] != 0:  # header: name\0 type\0 size value, until an empty name
-        end = buf.index(b"\0", pos)
-        end2 = buf.index(b"\0", end + 1)
-        (size,) = struct.unpack_from("<i", buf, end2 + 1)
-        attrs[buf[pos:end].decode()] = buf[end2 + 5:end2 + 5 + size]
-        pos = end2 + 5 + size
-    pos += 1
-    channels, cpos, chlist = [], 0, attrs["channels"]
-    while chlist[cpos] != 0:  # name\0 pixel_type pLinear reserved[3] xSampling ySampling
-        end = chlist.index(b"\0", cpos)
-        (ptype,) = struct.unpack_from("<i", chlist, end + 1)
-        sampling = struct.unpack_from("<ii", chlist, end + 9)
-        if sampling != (1, 1) or ptype not in (1, 2):
-            raise ValueError(f"{path}: subsampled or integer channels are not supported")
-        channels.append((chlist[cpos:end].decode(), np.dtype(np.float16 if ptype == 1 else np.float32)))
-        cpos = end + 17
-    comp = attrs["compression"][0]
-    if comp not in (0, 2, 3):
-        raise ValueError(f"{path}: compression {comp} is not supported (only none, ZIPS, ZIP)")
-    x0, y0, x1, y1 = struct.unpack("<iiii", attrs["dataWindow"])
-    width, height = x1 - x0 + 1, y1 - y0 + 1
-    out = {name: np.zeros((height, width), np.float32) for name, _ in channels}
-    if tiled:
-        tw, th, tmode = struct.unpack("<IIB", attrs["tiles"])
-        if tmode & 0xF:
-            raise ValueError(f"{path}: mip- or rip-mapped tiles are not supported")
-        nchunks = -(-width // tw) * -(-height // th)
-    else:
-        lines = 16 if comp == 3 else 1
-        nchunks = -(-height // lines)
-    for off in struct.unpack_from(f"<{nchunks}Q", buf, pos):
-        if tiled:
-            tx, ty, _, _, size = struct.unpack_from("<iiiii", buf, off)
-            data = buf[off + 20:off + 20 + size]
-            bx, by = tx * tw, ty * th
-            w, h = min(tw, width - bx), min(th, height - by)
-        else:
-            y, size = struct.unpack_from("<ii", buf, off)
-            data = buf[off + 8:off + 8 + size]
-            bx, by = 0, y - y0
-            w, h = width, min(lines, height - by)
-        raw_size = w * h * sum(t.itemsize for _, t in channels)
-        if comp != 0 and size < raw_size:  # zlib, then undo the predictor and the byte interleaving
-            t = np.frombuffer(zlib.decompress(data), np.uint8).astype(np.int64)
-            t[1:] -= 128
-            t = (np.cumsum(t) & 0xFF).astype(np.uint8)
-            half = (len(t) + 1) // 2
-            data = np.empty_like(t)
-            data[0::2], data[1::2] = t[:half], t[half:]
-            data = data.tobytes()
-        p = 0
-        for row in range(h):  # each scan line: every channel's w values, channels in header order
-            for name, typ in channels:
-                out[name][by + row, bx:bx + w] = np.frombuffer(data, typ, w, p)
-                p += w * typ.itemsize
-    return out
+# ----------------------------------------------------------------------------- Mitsuba worker
 
-
-class Estimate:
-    """spp-weighted running average of independent renders, with per-pixel second moments."""
-
-    def __init__(self):
-        self.sum = None
-        self.sum_m2 = None
-        self.spp = 0
-        self.seconds = 0.0
-
-    def add(self, rgb, m2, st):
-        s = st["spp"]
-        self.sum = rgb * s if self.sum is None else self.sum + rgb * s
-        self.sum_m2 = m2 * s if self.sum_m2 is None else self.sum_m2 + m2 * s
-        self.spp += s
-        self.seconds += st["seconds"]
-
-    @property
-    def mean(self):
-        return self.sum / self.spp
-
-    def mean_and_se(self):
-        """Image mean and its standard error (pixels independent)."""
-        mu = self.mean
-        var_pix = np.maximum(self.sum_m2 / self.spp - mu * mu, 0.0) / self.spp
-        return float(mu.mean()), float(math.sqrt(var_pix.sum()) / mu.size)
-
-
-def rel_mse(a, ref):
-    return float(np.mean((a - ref) ** 2 / (ref * ref + 1e-2)))
-
-
-# ----------------------------------------------------------------------------- Mitsuba 3
-
-def mitsuba_worker(spec_path):
-    """Runs in a subprocess (--mitsuba-worker SPEC.json): render one configuration's equal-time
-    series with Mitsuba's volpath and write result.json + runs.npz into spec["out"]."""
-    with open(spec_path) as fh:
-        spec = json.load(fh)
-    if "DRJIT_LIBLLVM_PATH" not in os.environ:
-        for cand in MI_LLVM_CANDIDATES:
-            if os.path.exists(cand):
-                os.environ["DRJIT_LIBLLVM_PATH"] = cand
-                break
+def mitsuba_worker(scene, threads, variant):
+    """Runs in a subprocess: load SCENE once, then answer JSON commands read line by line on stdin
+    with one line "@@{json}" on stdout each: {"cmd": "probe", "seconds": S}, {"cmd": "render",
+    "spp": N, "seed": S, "out": NPY or null}, {"cmd": "firefly", "scale": K, "seed": S, "out": NPY}."""
+    def reply(obj):
+        sys.stdout.write("@@" + json.dumps(obj) + "\n")
+        sys.stdout.flush()
     try:
-        import drjit as dr
-        import mitsuba as mi
+        mi, dr, variant, notes = common.mitsuba_setup(variant)
     except ImportError as err:
-        print(f"cannot import mitsuba: {err}", file=sys.stderr)
+        reply({"error": f"cannot import mitsuba: {err}"})
         return MI_NOT_INSTALLED
-    variant, notes = None, []
-    wanted = ["llvm_ad_rgb", "scalar_rgb"] if spec["variant"] == "auto" else [spec["variant"]]
-    for v in wanted:
-        try:
-            mi.set_variant(v)
-            if v.startswith("llvm"):  # set_variant succeeds without libLLVM; the first kernel fails
-                x = mi.Float(1.0) + 1.0
-                dr.eval(x)
-            variant = v
-            break
-        except Exception as err:  # noqa: BLE001 - any failure to set up the JIT backend
-            notes.append(f"{v} unavailable: {str(err).splitlines()[0] if str(err) else type(err).__name__}")
-    if variant is None:
-        print("no usable Mitsuba variant: " + "; ".join(notes), file=sys.stderr)
-        return 2
     llvm = variant.startswith("llvm")
     if llvm:
         dr.set_flag(dr.JitFlag.KernelHistory, True)
-
     t0 = time.perf_counter()
-    scene = mi.load_file(spec["scene"], integrator="volpath")
+    sc = mi.load_file(scene, integrator="volpath")
     load_seconds = time.perf_counter() - t0
-    # The thread count is set only now: with a 1-thread pool, Mitsuba 3.9.1 / drjit 1.5 deadlock while
-    # loading the envmap scenes (both variants); rendering with it works.
-    dr.set_thread_count(spec["threads"])
-    # `moment` around the scene's volpath: its first three channels are volpath's image (the same
-    # samples as without it), then nested.X/Y/Z and m2_nested.X/Y/Z.
-    integrator = mi.load_dict({"type": "moment", "nested": scene.integrator()})
-    width, height = scene.sensors()[0].film().crop_size()
-    pass_spp = max(1, MI_MAX_SAMPLES_PER_PASS // (width * height))
+    # Set only now: with a 1-thread pool Mitsuba 3.9.1 deadlocks loading the envmap scenes.
+    dr.set_thread_count(threads)
+    width, height = sc.sensors()[0].film().crop_size()
+    scaled = {}
 
-    def run(spp, seed):
-        """spp samples in passes; returns the mean image (H, W, 9) and the timings."""
+    def run(scene_obj, spp, seed):
         if llvm:
             dr.kernel_history()  # clears the history
-        acc, done, k = None, 0, 0
         c0, t0 = time.process_time(), time.perf_counter()
-        while done < spp:
-            n = min(pass_spp, spp - done)
-            img = np.array(mi.render(scene, integrator=integrator, seed=seed + k, spp=n), dtype=np.float64)
-            acc = img * n if acc is None else acc + img * n
-            done += n
-            k += 1
+        img = np.array(mi.render(scene_obj, seed=seed, spp=spp), dtype=np.float32)
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         compile_s = sum(h.get("backend_time", 0.0) for h in dr.kernel_history()) / 1000.0 if llvm else 0.0
-        timing = {"spp": spp, "seed": seed, "passes": k, "seconds": wall - compile_s, "wall_seconds": wall,
-                  "cpu_seconds": cpu, "compile_seconds": compile_s}
-        return acc / spp, timing
+        return img[..., :3], {"spp": spp, "seed": seed, "seconds": wall - compile_s, "wall_seconds": wall,
+                              "cpu_seconds": cpu, "compile_seconds": compile_s}
 
-    _, warmup = run(1, 1)
-    _, probe = run(MI_PROBE_SPP, 2)
-    rate = MI_PROBE_SPP / max(probe["seconds"], 1e-6)
-    runs, arrays, spp_sum, sec_sum = [], {}, 0, 0.0
-    for i, target in enumerate(np.cumsum(spec["series"])):
-        if i > 0:
-            rate = spp_sum / sec_sum
-        spp = max(1, int(round(rate * (target - sec_sum))))
-        img, timing = run(spp, 1000 * (i + 1))
-        runs.append(timing)
-        spp_sum += spp
-        sec_sum += timing["seconds"]
-        arrays[f"rgb{i}"] = img[..., 0:3].astype(np.float32)
-        arrays[f"y{i}"] = img[..., 4].astype(np.float32)
-        arrays[f"m2y{i}"] = img[..., 7].astype(np.float32)
-    os.makedirs(spec["out"], exist_ok=True)
-    np.savez_compressed(os.path.join(spec["out"], "runs.npz"), **arrays)
-    result = {"spec": spec, "variant": variant, "variant_notes": notes, "mitsuba_version": mi.__version__,
-              "thread_count": dr.thread_count(), "load_seconds": load_seconds, "warmup": warmup,
-              "probe": probe, "runs": runs}
-    tmp = os.path.join(spec["out"], "result.json.tmp")
-    with open(tmp, "w") as fh:
-        json.dump(result, fh, indent=1)
-    os.replace(tmp, os.path.join(spec["out"], "result.json"))
+    reply({"ready": True, "variant": variant, "notes": notes, "load_seconds": load_seconds,
+           "mitsuba_version": mi.__version__, "thread_count": dr.thread_count(), "size": [width, height]})
+    for line in sys.stdin:
+        cmd = json.loads(line)
+        if cmd["cmd"] == "quit":
+            break
+        if cmd["cmd"] == "probe":  # doubling spp until a render takes at least a quarter of the budget
+            run(sc, 1, 1)
+            spp = 1
+            while True:
+                _, t = run(sc, spp, 2)
+                if t["seconds"] >= cmd["seconds"] / 4 or spp >= 1 << 20:
+                    break
+                spp *= 2
+            reply({"rate": spp / max(t["seconds"], 1e-9), "probe": t})
+        elif cmd["cmd"] == "render":
+            img, t = run(sc, cmd["spp"], cmd["seed"])
+            if cmd.get("out"):
+                np.save(cmd["out"], img)
+            reply(t)
+        elif cmd["cmd"] == "firefly":
+            k = cmd["scale"]
+            if k not in scaled:
+                scaled[k] = mi.load_file(scene, integrator="volpath", width=width * k, height=height * k)
+            img, t = run(scaled[k], 1, cmd["seed"])
+            np.save(cmd["out"], img)
+            reply(t)
     return 0
 
 
-def mitsuba_series(args, work, config, series):
-    """Mitsuba's runs for one configuration (cached in WORK/mitsuba/CONFIG): a dict with status "ok",
-    the worker's result and the per-run arrays, or status "not installed" / "failed: ..."."""
-    out = os.path.join(work, "mitsuba", config)
-    spec = {"scene": os.path.join(SCENES, config + ".xml"), "threads": args.threads, "series": list(series),
-            "variant": args.mitsuba_variant, "out": out}
-    result_path = os.path.join(out, "result.json")
-    cached = None
-    if not args.force and os.path.exists(result_path):
-        with open(result_path) as fh:
-            cached = json.load(fh)
-        if cached.get("spec") != spec:
-            cached = None
-    if cached is None:
-        os.makedirs(out, exist_ok=True)
-        if os.path.exists(result_path):
-            os.remove(result_path)
-        spec_path = os.path.join(out, "spec.json")
-        with open(spec_path, "w") as fh:
-            json.dump(spec, fh, indent=1)
-        cmd = [sys.executable, os.path.abspath(__file__), "--mitsuba-worker", spec_path]
-        try:
-            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120 + 10 * sum(series))
-        except subprocess.TimeoutExpired:
-            return {"status": "failed: timed out"}
-        if proc.returncode == MI_NOT_INSTALLED:
-            return {"status": "not installed", "detail": proc.stderr.strip()}
-        if proc.returncode != 0 or not os.path.exists(result_path):
-            tail = "\n".join(proc.stderr.strip().splitlines()[-15:])
-            print(f"warning: Mitsuba failed on {config} (exit code {proc.returncode}):\n{tail}", file=sys.stderr)
-            last = tail.splitlines()[-1] if tail else f"exit code {proc.returncode}"
-            return {"status": f"failed: {last[:200]}"}
-        with open(result_path) as fh:
-            cached = json.load(fh)
-    with np.load(os.path.join(out, "runs.npz")) as z:
-        arrays = {k: z[k].astype(np.float64) for k in z.files}
-    return {"status": "ok", "result": cached, "arrays": arrays}
+class Mitsuba:
+    """The persistent worker, started on first use; status "ok", "not installed" or "failed: ..."."""
+
+    def __init__(self, args, config):
+        self.args, self.config, self.proc, self.info, self.status = args, config, None, None, "ok"
+
+    def call(self, cmd):
+        if self.status != "ok":
+            return None
+        if self.proc is None:
+            spec = [sys.executable, os.path.abspath(__file__), "--mitsuba-worker",
+                    os.path.join(SCENES, self.config + ".xml"), str(self.args.threads), self.args.mitsuba_variant]
+            self.proc = subprocess.Popen(spec, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+            self.info = self._read()
+            if self.info is None or "error" in self.info:
+                self.status = "not installed" if self.info and "import" in self.info.get("error", "") else \
+                    f"failed: {(self.info or {}).get('error', 'worker exited')}"
+                return None
+        self.proc.stdin.write(json.dumps(cmd) + "\n")
+        self.proc.stdin.flush()
+        r = self._read()
+        if r is None:
+            self.status = "failed: worker exited"
+        return r
+
+    def _read(self):
+        for line in self.proc.stdout:
+            if line.startswith("@@"):
+                return json.loads(line[2:])
+        return None
+
+    def close(self):
+        if self.proc is not None:
+            try:
+                self.proc.stdin.write('{"cmd": "quit"}\n')
+                self.proc.stdin.close()
+            except (BrokenPipeError, OSError):
+                pass
+            self.proc.wait(timeout=60)
 
 
-class MitsubaEstimate:
-    """spp-weighted running average of Mitsuba's runs: RGB image, luminance and its second moment."""
+# ----------------------------------------------------------------------------- statistics
 
-    def __init__(self):
-        self.rgb = self.y = self.m2y = None
-        self.spp = 0
-        self.seconds = 0.0
+def moment_var(ch, n, prefix=""):
+    """Per-pixel, per-channel unbiased per-sample variance from a --moment render of n spp."""
+    x = rgb_of(ch, prefix)
+    m2 = rgb_of(ch, prefix + "m2.") if prefix == "" else rgb_of(ch, prefix[:-1] + ".m2.")
+    return np.maximum(m2 - x * x, 0.0) * n / max(n - 1, 1)
 
-    def add(self, rgb, y, m2y, spp, seconds):
-        if self.rgb is None:
-            self.rgb, self.y, self.m2y = rgb * spp, y * spp, m2y * spp
+
+def mean_se_bound(mean, var_sample, n):
+    """Image mean (pixels, channels) and an upper bound of its standard error (channels of a pixel
+    fully correlated: sd of the channel average <= average of the channel sds)."""
+    sd_pix = np.sqrt(var_sample / n).mean(axis=-1)
+    return float(mean.mean()), float(math.sqrt(np.sum(sd_pix ** 2)) / sd_pix.size)
+
+
+def zscore(mu, se, ref_mu, ref_se):
+    den = math.sqrt(se * se + ref_se * ref_se)
+    return (mu - ref_mu) / den if den > 0 else (0.0 if mu == ref_mu else math.copysign(math.inf, mu - ref_mu))
+
+
+def class_shares(ch, n, denom):
+    """Per transport class (channels CLASS.R/G/B, CLASS.m2.R/G/B of a --classes --moment render of n
+    spp): its share V_class / V of the per-sample relative variance, and the classes' sum against
+    the image (max relative difference)."""
+    names = sorted({c[:-2] for c in ch if c.endswith(".R") and not c.startswith("m2.") and ".m2." not in c})
+    v_total = float(np.mean(moment_var(ch, n) / denom))
+    img = rgb_of(ch)
+    total = sum(rgb_of(ch, c + ".") for c in names)
+    return {"V": v_total, "sum_max_rel_diff": float(np.max(np.abs(total - img)) / max(np.max(np.abs(img)), 1e-30)),
+            "share": {c: safe_div(float(np.mean(moment_var(ch, n, c + ".") / denom)), v_total) for c in names}}
+
+
+def safe_div(a, b):
+    """a / b with x / 0 = inf (x > 0), 0 / 0 = nan, inf / inf = nan."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return float(np.float64(a) / np.float64(b))
+
+
+def firefly_rate(img, ref_mean_lum):
+    lum = img @ LUM
+    return float(np.count_nonzero(lum > FIREFLY_FACTOR * ref_mean_lum) / lum.size * 1e6)
+
+
+# ----------------------------------------------------------------------------- one configuration
+
+def reference(args, P, work, name):
+    light, boundary, _ = name.split("_")
+    parts, out = [], {}
+    budget = P["ref_factor"] * P["run_time"]
+    if light == "directional" and boundary == "smooth":
+        out["kind"] = (f"volpath, sphere lights of {', '.join(f'{o:g}' for o in P['omegas'])} sr at equal irradiance, "
+                       "image mean extrapolated to 0 sr")
+        pts = []
+        for omega in P["omegas"]:
+            xml = variant_xml(work, name, "volpath", omega)
+            est_parts = []
+            for k in range(P["ref_parts"]):
+                ch, st = snee_render(args, work, xml, f"{name}.ref.omega{omega:g}.{k}", seed=5000 + k, extra=["--moment"],
+                                     seconds=budget / len(P["omegas"]) / P["ref_parts"])
+                est_parts.append((ch, st))
+            n = sum(st["spp"] for _, st in est_parts)
+            mean = sum(rgb_of(ch) * st["spp"] for ch, st in est_parts) / n
+            m2 = sum(rgb_of(ch, "m2.") * st["spp"] for ch, st in est_parts) / n
+            mu, se = mean_se_bound(mean, np.maximum(m2 - mean * mean, 0) * n / (n - 1), n)
+            pts.append({"omega": omega, "mean": mu, "se": se, "spp": n,
+                        "seconds": sum(st["seconds"] for _, st in est_parts)})
+            parts += est_parts
+            out.setdefault("images", []).append(mean)
+        if any(p["se"] <= 0 for p in pts):  # a radius never hit: no extrapolation
+            pts = [dict(p, se=math.inf if p["se"] <= 0 else p["se"]) for p in pts]
+        x = np.array([p["omega"] for p in pts])
+        y = np.array([p["mean"] for p in pts])
+        w = 1.0 / np.array([p["se"] for p in pts]) ** 2
+        a = np.vstack([np.ones_like(x), x]).T
+        if np.count_nonzero(w) >= 2:
+            cov = np.linalg.inv(a.T @ (a * w[:, None]))
+            coef = cov @ (a.T @ (w * y))
+            chi2 = float(np.sum(w * (y - a @ coef) ** 2))
         else:
-            self.rgb, self.y, self.m2y = self.rgb + rgb * spp, self.y + y * spp, self.m2y + m2y * spp
-        self.spp += spp
-        self.seconds += seconds
+            cov, coef, chi2 = np.full((2, 2), np.nan), np.full(2, np.nan), math.nan
+        out.update(mean=float(coef[0]), se=float(math.sqrt(cov[0, 0])), slope=float(coef[1]), chi2=chi2,
+                   dof=len(pts) - 2, points=pts, seconds=sum(p["seconds"] for p in pts),
+                   spp=sum(p["spp"] for p in pts))
+        # No per-pixel reference here (only the extrapolated mean): relMSE is not reported. The
+        # volpath renders of the sphere lights are too sparse for a per-pixel median, so d comes from
+        # independent volpath_snee renders (seeds the runs never use; d only weights pixels).
+        out.pop("images")
+        out["image"] = None
+        out["d_from"] = f"volpath_snee, {P['ref_parts']} x {2 * P['run_time']:g} s (seeds 6000+)"
+        parts = [snee_render(args, work, variant_xml(work, name, "snee"), f"{name}.d.{k}", seed=6000 + k,
+                             seconds=2 * P["run_time"]) for k in range(P["ref_parts"])]
+        out["d"] = robust_d(parts)
+        out["mean_lum"] = float(np.mean([(rgb_of(ch) @ LUM).mean() for ch, _ in parts]))
+    else:
+        out["kind"] = f"volpath, {P['ref_parts']} x {budget / P['ref_parts']:g} s"
+        xml = variant_xml(work, name, "volpath")
+        for k in range(P["ref_parts"]):
+            parts.append(snee_render(args, work, xml, f"{name}.ref.{k}", seed=5000 + k, extra=["--moment"],
+                                     seconds=budget / P["ref_parts"]))
+        n = sum(st["spp"] for _, st in parts)
+        mean = sum(rgb_of(ch) * st["spp"] for ch, st in parts) / n
+        m2 = sum(rgb_of(ch, "m2.") * st["spp"] for ch, st in parts) / n
+        var = np.maximum(m2 - mean * mean, 0) * n / (n - 1)
+        mu, se = mean_se_bound(mean, var, n)
+        out.update(mean=mu, se=se, image=mean, var_of_image=var / n)
+        out["seconds"] = sum(st["seconds"] for _, st in parts)
+        out["spp"] = n
+        out["d"] = robust_d(parts)
+        out["d_from"] = "the reference's parts"
+        out["mean_lum"] = float((mean @ LUM).mean())
+    out["eps"] = 1e-2 * max(float(out["d"].mean()), abs(out["mean"])) ** 2
+    return out
 
-    @property
-    def mean(self):
-        return self.rgb / self.spp
 
-    def y_mean_and_se(self):
-        mu = self.y / self.spp
-        var_pix = np.maximum(self.m2y / self.spp - mu * mu, 0.0) / self.spp
-        return float(mu.mean()), float(math.sqrt(var_pix.sum()) / mu.size)
-
-
-def y_mean_and_se_bound(est):
-    """Luminance mean of a snee estimate, and an upper bound of its standard error: per-pixel
-    sd(Y) <= sum_c w_c sd(c) (channels fully correlated; no cross moments are recorded)."""
-    mu = est.mean
-    sd = np.sqrt(np.maximum(est.sum_m2 / est.spp - mu * mu, 0.0) / est.spp)
-    var_y = (sd @ Y_WEIGHTS) ** 2
-    return float((mu @ Y_WEIGHTS).mean()), float(math.sqrt(var_y.sum()) / var_y.size)
+def robust_d(parts):
+    """Per-pixel, per-channel median over independent renders of their 3x3 box-filtered images:
+    the smoothing gives each estimate 9 pixels' samples, the median drops a part's fireflies."""
+    imgs = []
+    for ch, _ in parts:
+        x = np.pad(rgb_of(ch), ((1, 1), (1, 1), (0, 0)), mode="edge")
+        h, w = x.shape[0] - 2, x.shape[1] - 2
+        imgs.append(sum(x[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)) / 9.0)
+    return np.median(np.stack(imgs), axis=0)
 
 
-# ----------------------------------------------------------------------------- analysis
+def run_config(args, P, work, name):
+    """Everything for one configuration; cached in WORK/results/NAME.json (+ .npz of images)."""
+    res_path = os.path.join(work, "results", name + ".json")
+    img_path = os.path.join(work, "results", name + ".npz")
+    if not args.force and os.path.exists(res_path) and os.path.exists(img_path):
+        with open(res_path) as fh:
+            return json.load(fh)
+    os.makedirs(os.path.dirname(res_path), exist_ok=True)
+    t_cfg = time.time()
+    load0 = os.getloadavg()[0]
+    rendered0 = RENDERED[0]
+    ref = reference(args, P, work, name)
+    denom = ref["d"] ** 2 + ref["eps"]
+    res = {"name": name, "reference": {k: v for k, v in ref.items() if k not in ("image", "d", "var_of_image")}}
+    if "var_of_image" in ref:
+        res["reference"]["rv"] = float(np.mean(ref["var_of_image"] / denom))
 
-def fit_power(ts, errs):
-    """Least-squares fit of log relMSE = log c + s log t; returns (c, s)."""
-    lt, le = np.log(ts), np.log(np.maximum(errs, 1e-300))
-    s, lc = np.polyfit(lt, le, 1)
-    return float(math.exp(lc)), float(s)
+    # Probes (rates), then interleaved runs at fixed spp.
+    mit = Mitsuba(args, name) if not args.no_mitsuba else None
+    runs = {"volpath": [], "snee": [], "mitsuba": []}
+    spp, mstat = {}, {}
+    for m in ("volpath", "snee"):
+        _, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.probe", seed=90,
+                            seconds=P["run_time"])
+        spp[m] = max(2, int(round(st["spp"] / st["seconds"] * P["run_time"])))
+    if mit is not None:
+        rdir = os.path.join(work, "renders")
+        setup_json = os.path.join(rdir, f"{name}.mitsuba.setup.json")
+        cached = not args.force_renders and os.path.exists(os.path.join(rdir, f"{name}.mitsuba.firefly.npy")) and all(
+            os.path.exists(os.path.join(rdir, f"{name}.mitsuba.run{i}.{x}")) for i in range(P["runs"]) for x in ("json", "npy"))
+        if cached:  # the runs exist: no worker, no probe
+            if os.path.exists(setup_json):
+                with open(setup_json) as fh:
+                    mstat = json.load(fh)
+            elif os.path.exists(res_path):  # written before set-up files existed: the earlier result has it
+                with open(res_path) as fh:
+                    mstat = json.load(fh).get("mitsuba", {})
+            with open(os.path.join(rdir, f"{name}.mitsuba.run0.json")) as fh:
+                spp["mitsuba"] = json.load(fh)["spp"]
+        else:
+            pr = mit.call({"cmd": "probe", "seconds": P["run_time"]})
+            if pr is not None:
+                spp["mitsuba"] = max(2, int(round(pr["rate"] * P["run_time"])))
+                mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 3, "out": None})  # warm-up: compiles
+                mstat = {"variant": mit.info["variant"], "notes": mit.info["notes"], "probe": pr,
+                         "load_seconds": mit.info["load_seconds"], "thread_count": mit.info["thread_count"]}
+                os.makedirs(rdir, exist_ok=True)
+                common.write_json_atomic(setup_json, mstat)
+    for i in range(P["runs"]):
+        for m in ("volpath", "snee"):
+            ch, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.run{i}",
+                                 seed=(100 if m == "volpath" else 200) + i, spp=spp[m], extra=["--moment"])
+            runs[m].append({"x": rgb_of(ch), "var": moment_var(ch, st["spp"]), "n": st["spp"], "t": st["seconds"]})
+        if "mitsuba" in spp:
+            npy = os.path.join(work, "renders", f"{name}.mitsuba.run{i}.npy")
+            tj = npy[:-4] + ".json"
+            if args.force_renders or not (os.path.exists(npy) and os.path.exists(tj)):
+                RENDERED[0] += 1
+                t = mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 1000 + i, "out": npy})
+                if t is None:
+                    break
+                common.write_json_atomic(tj, t)
+            with open(tj) as fh:
+                t = json.load(fh)
+            runs["mitsuba"].append({"x": np.load(npy).astype(np.float64), "n": t["spp"], "t": t["seconds"],
+                                    "cpu": t["cpu_seconds"]})
+    if "mitsuba" in spp and len(runs["mitsuba"]) < P["runs"]:
+        runs["mitsuba"] = []
+    res["mitsuba_status"] = "not run (--no-mitsuba)" if mit is None else mit.status
+    res["mitsuba"] = mstat
+
+    # Firefly renders.
+    k = P["firefly_scale"]
+    w, h = ref["d"].shape[1], ref["d"].shape[0]
+    ff = {}
+    for m in ("volpath", "snee"):
+        ch, _ = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.firefly", seed=77, spp=1,
+                            extra=["-D", f"width={w * k}", "-D", f"height={h * k}"])
+        ff[m] = firefly_rate(rgb_of(ch), ref["mean_lum"])
+    if runs["mitsuba"]:
+        npy = os.path.join(work, "renders", f"{name}.mitsuba.firefly.npy")
+        if args.force_renders or not os.path.exists(npy):
+            mit.call({"cmd": "firefly", "scale": k, "seed": 77, "out": npy})
+        if os.path.exists(npy):
+            ff["mitsuba"] = firefly_rate(np.load(npy).astype(np.float64), ref["mean_lum"])
+
+    # Transport classes (when the binary has them).
+    classes = {}
+    if args.classes:
+        for m in ("volpath", "snee"):
+            ch, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.classes", seed=400,
+                                 spp=spp[m], extra=["--moment", "--classes"])
+            classes[m] = class_shares(ch, st["spp"], denom)
+    if mit is not None:
+        mit.close()
+
+    # Per-method statistics.
+    N = P["runs"]
+    stats, avg = {}, {}
+    for m, rs in runs.items():
+        if len(rs) < N:
+            continue
+        n = rs[0]["n"]
+        X = np.stack([r["x"] for r in rs])
+        t = np.array([r["t"] for r in rs])
+        run_means = X.mean(axis=(1, 2, 3))
+        spread = (X.var(axis=0, ddof=1) / denom).reshape(-1)  # per pixel-channel s^2 / denom
+
+        # Bootstrap of the spread estimate through the runs' Gram matrix G_ij = mean_p x_ip x_jp / denom_p:
+        # for weights w_i = count_i / N, the ddof-1 variance averaged over pixels is
+        # N / (N - 1) (sum_i w_i G_ii - w^T G w); times N / (N - 1) for the bootstrap's bias.
+        xd = (X / np.sqrt(denom)).reshape(N, -1)
+        gram = xd @ xd.T / xd.shape[1]
+
+        def v_spread(idx, gram=gram, n=n):
+            w = np.bincount(idx, minlength=N) / N
+            return n * float(w @ np.diag(gram) - w @ gram @ w) * (N / (N - 1)) ** 2
+        s = {"spp": n, "t": t.tolist(), "c": float(t.sum() / (N * n)), "run_means": run_means.tolist(),
+             "V_spread": n * float(spread.mean())}
+        if m != "mitsuba":
+            vm = np.array([float(np.mean(r["var"] / denom)) for r in rs])
+            s["V_runs"] = vm.tolist()
+            s["V"] = float(vm.mean())
+        else:
+            s["V"] = s["V_spread"]
+            s["cpu_per_second"] = float(sum(r["cpu"] for r in rs) / t.sum())
+        s["efficiency"] = safe_div(1.0, s["V"] * s["c"])
+        a = X.mean(axis=0)
+        avg[m] = a
+        mu = float(run_means.mean())
+        if m != "mitsuba":  # standard error of the mean of all N n samples per pixel (moments)
+            _, se = mean_se_bound(a, np.mean([r["var"] for r in rs], axis=0), N * n)
+            z = zscore(mu, se, ref["mean"], ref["se"])
+        else:  # only the N runs' means: a t statistic with N - 1 degrees of freedom, as the equivalent z
+            from scipy.stats import norm
+            from scipy.stats import t as student_t
+            se = float(run_means.std(ddof=1) / math.sqrt(N))
+            tstat = zscore(mu, se, ref["mean"], ref["se"])
+            s["t_stat"] = tstat
+            z = math.copysign(float(norm.isf(student_t.sf(abs(tstat), N - 1))), tstat) if math.isfinite(tstat) else tstat
+        s.update(mean=mu, se=se, z=z,
+                 relmse=None if ref["image"] is None else common.rel_mse(a, ref["image"], denom),
+                 relmse_k={} if ref["image"] is None else
+                 {str(kk): common.rel_mse(X[:kk].mean(axis=0), ref["image"], denom) for kk in (1, 2, 4, 8) if kk <= N},
+                 firefly_per_1e6=ff.get(m))
+        s["_X"] = X
+        s["_vspread"] = v_spread
+        stats[m] = s
+
+    def eff(m, idx):
+        s = stats[m]
+        v = s["_vspread"](idx) if m == "mitsuba" else float(np.mean(np.array(s["V_runs"])[idx]))
+        return safe_div(1.0, v * float(np.sum(np.array(s["t"])[idx]) / (len(idx) * s["spp"])))
+
+    ratios = {}
+    for other in ("volpath", "mitsuba"):
+        if "snee" in stats and other in stats:
+            r = safe_div(stats["snee"]["efficiency"], stats[other]["efficiency"])
+            lo, hi = common.bootstrap_ci(lambda idx, o=other: safe_div(eff("snee", idx), eff(o, idx)), N, b=P["boot"])
+            ratios[other] = {"ratio": r, "lo": lo, "hi": hi}
+    for m in stats:
+        v = stats[m]
+        v["V_ci"] = list(common.bootstrap_ci(lambda idx, m=m: (stats[m]["_vspread"](idx) if m == "mitsuba" else
+                                                             float(np.mean(np.array(stats[m]["V_runs"])[idx]))),
+                                             N, b=P["boot"]))
+        del v["_X"], v["_vspread"]
+    res["methods"] = stats
+    res["ratios"] = ratios
+    res["classes"] = classes
+
+    # Figure 3: equal samples, SNEE's transport only.
+    f3 = {}
+    for v in ("fig3_forward", "fig3_snee"):
+        ch, st = snee_render(args, work, variant_xml(work, name, v), f"{name}.{v}", seed=7, spp=P["fig3_spp"],
+                             extra=["--moment"])
+        f3[v] = (rgb_of(ch), *mean_se_bound(rgb_of(ch), moment_var(ch, st["spp"]), st["spp"]))
+    res["fig3"] = {"forward_mean": f3["fig3_forward"][1], "snee_mean": f3["fig3_snee"][1],
+                   "z_forward_vs_snee": zscore(f3["fig3_forward"][1], f3["fig3_forward"][2],
+                                               f3["fig3_snee"][1], f3["fig3_snee"][2])}
+    res["wall_seconds"] = time.time() - t_cfg
+    res["load_average"] = [load0, os.getloadavg()[0]]
+    if RENDERED[0] == rendered0 and os.path.exists(res_path):  # nothing rendered: keep the rendering run's
+        with open(res_path) as fh:
+            old = json.load(fh)
+        res["wall_seconds"], res["load_average"] = old.get("wall_seconds"), old.get("load_average")
+    np.savez_compressed(img_path, ref=ref["d"] if ref["image"] is None else ref["image"], f3_forward=f3["fig3_forward"][0], f3_snee=f3["fig3_snee"][0],
+                        **{f"avg_{m}": a for m, a in avg.items()})
+    common.write_json_atomic(res_path, finite(res))
+    return finite(res)
 
 
-def time_to(c, s, target):
-    if s > -0.5:
-        return math.inf
-    return (target / c) ** (1.0 / s)
+def run_config_task(argv, name):
+    """Ray task: the same as the local loop for one configuration (PYTHONPATH has scripts/)."""
+    args, P, work = setup(argv)
+    return run_config(args, P, work, name)
 
+
+# ----------------------------------------------------------------------------- outputs
 
 def finite(x):
-    """JSON-safe copy: non-finite floats become null."""
+    """JSON-safe copy: numpy scalars to floats, non-finite floats to null."""
     if isinstance(x, dict):
         return {k: finite(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [finite(v) for v in x]
     if isinstance(x, (float, np.floating)):
         return float(x) if math.isfinite(x) else None
+    if isinstance(x, np.integer):
+        return int(x)
     return x
 
 
 def fmt(x, digits=3):
     if x is None or (isinstance(x, float) and math.isnan(x)):
         return "n/a"
-    if isinstance(x, float) and math.isinf(x):
-        return "never"
     return f"{x:.{digits}g}"
 
 
@@ -474,13 +658,12 @@ def tonemap(img, scale):
 def split(left, right):
     w = left.shape[1]
     out = np.concatenate([left[:, : w // 2], right[:, w // 2:]], axis=1)
-    out[:, w // 2 - 0] = 1.0  # a thin white divider
+    out[:, w // 2] = 1.0  # a thin white divider
     return out
 
 
 def exposure(ref):
-    lum = ref @ np.array([0.2126, 0.7152, 0.0722])
-    return 0.9 / max(np.percentile(lum, 99.0), 1e-6)
+    return 0.9 / max(np.percentile(ref @ LUM, 99.0), 1e-6)
 
 
 def grid_png(path, title, tiles, note):
@@ -509,23 +692,16 @@ def grid_png(path, title, tiles, note):
     plt.close(fig)
 
 
-METHODS = [  # key in the results, legend label, plot style
-    ("volpath", "snee volpath", dict(marker="o", color="C0", ls="-")),
-    ("snee", "snee volpath_snee", dict(marker="s", color="C1", ls="-")),
-    ("mitsuba", "Mitsuba volpath", dict(marker="^", color="C2", ls="--")),
-]
-
-
-def chart_png(path, results, mode, cum_times, mi_note):
-    """relMSE vs time, log-log: rows = lights, columns = extinction x boundary."""
+def chart_png(path, results, P, note):
+    """Relative error against render time per configuration: RV(t) = V c / t (band: the bootstrap
+    interval of V) for k = 1, 2, 4, 8 runs averaged, and relMSE of those averages against the
+    reference (markers); dotted: the reference's own RV."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, NullFormatter, NullLocator
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
     cols = [(e, b) for e in EXTINCTIONS for b in BOUNDARIES]
-    fig, axes = plt.subplots(len(LIGHTS), len(cols), figsize=(2.75 * len(cols), 2.5 * len(LIGHTS) + 1.0),
-                             squeeze=False)
-    label = FuncFormatter(lambda v, _: f"{v:g}")
+    fig, axes = plt.subplots(len(LIGHTS), len(cols), figsize=(2.75 * len(cols), 2.5 * len(LIGHTS) + 1.0), squeeze=False)
     handles = {}
     for r, l in enumerate(LIGHTS):
         for c, (e, b) in enumerate(cols):
@@ -534,272 +710,236 @@ def chart_png(path, results, mode, cum_times, mi_note):
             if r == 0:
                 ax.set_title(f"{LABEL[e]}, {LABEL[b]}", fontsize=9)
             if c == 0:
-                ax.set_ylabel(f"{LABEL[l]}\nrelMSE", fontsize=9)
+                ax.set_ylabel(f"{LABEL[l]}\nrelative error", fontsize=9)
             if res is None:
-                ax.text(0.5, 0.5, "not rendered", ha="center", va="center", fontsize=8, color="gray",
-                        transform=ax.transAxes)
                 ax.set_xticks([])
                 ax.set_yticks([])
                 continue
-            lo, hi = res["ref_floor"], res["ref_floor"]
-            t_lo, t_hi = cum_times[0], cum_times[-1]
-            for key, name, style in METHODS:
-                m = res.get(key, {})
-                if not m.get("times"):
+            for key, label, style in METHODS:
+                s = res["methods"].get(key)
+                if not s:
                     continue
-                (h,) = ax.loglog(m["times"], m["relmse"], ms=3.5, lw=1.2, label=name, **style)
-                handles[name] = h
-                lo, hi = min(lo, min(m["relmse"])), max(hi, max(m["relmse"]))
-                t_lo, t_hi = min(t_lo, min(m["times"])), max(t_hi, max(m["times"]))
-            h = ax.axhline(res["ref_floor"], color="gray", lw=0.8, ls=":", label="reference noise floor")
-            handles["reference noise floor"] = h
-            # Few, plain tick labels: x at the series' times, y at decades (1-2-5 if < 1.5 decades).
-            ax.set_xlim(t_lo / 1.25, t_hi * 1.25)
-            ax.xaxis.set_major_locator(FixedLocator(cum_times))
-            ax.xaxis.set_major_formatter(label)
+                ks = np.array([kk for kk in (1, 2, 4, 8) if kk <= P["runs"]])
+                tk = ks * float(np.mean(s["t"]))
+                rv = s["V"] * s["c"] / tk
+                lo, hi = (np.array(s["V_ci"]) * s["c"])[:, None] / tk[None, :] if s.get("V_ci") and None not in s["V_ci"] else (rv, rv)
+                (hl,) = ax.loglog(tk, rv, color=style["color"], lw=1.2, label=f"{label}: RV")
+                ax.fill_between(tk, lo, hi, color=style["color"], alpha=0.2, lw=0)
+                rm = [s["relmse_k"].get(str(kk), np.nan) for kk in ks]
+                (hm,) = ax.loglog(tk, rm, ls="none", mfc="none", ms=4, label=f"{label}: relMSE vs ref", **style)
+                handles[hl.get_label()] = hl
+                handles[hm.get_label()] = hm
+            rv_ref = res["reference"].get("rv")
+            if rv_ref:
+                hr = ax.axhline(rv_ref, color="gray", ls=":", lw=0.8, label="reference's own RV")
+                handles[hr.get_label()] = hr
+            ax.xaxis.set_major_locator(FixedLocator([float(np.mean(res["methods"][m]["t"])) * kk for m in
+                                                     list(res["methods"])[:1] for kk in (1, 2, 4, 8)]))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
             ax.xaxis.set_minor_locator(NullLocator())
-            ax.set_ylim(lo / 1.5, hi * 1.5)
-            subs = (1.0,) if math.log10(hi / lo) > 1.2 else (1.0, 2.0, 5.0)
-            ax.yaxis.set_major_locator(LogLocator(base=10, subs=subs, numticks=6))
-            ax.yaxis.set_major_formatter(label)
             ax.yaxis.set_minor_formatter(NullFormatter())
-            ax.tick_params(labelsize=7, pad=1.5)
+            ax.tick_params(labelsize=7)
             ax.grid(True, which="major", lw=0.3, alpha=0.5)
             if r == len(LIGHTS) - 1:
                 ax.set_xlabel("render time [s]", fontsize=8)
-    fig.legend(list(handles.values()), list(handles.keys()), loc="lower center", ncol=len(handles), fontsize=9,
-               frameon=False)
-    fig.suptitle(f"relMSE vs render time, log-log ({mode} mode; reference: volpath_snee, "
-                 f"2 x {MODES[mode]['ref_time']:g} s; {mi_note})", fontsize=10)
-    fig.tight_layout(rect=(0, 0.04, 1, 0.97), h_pad=0.6, w_pad=0.4)
+    fig.legend(list(handles.values()), list(handles.keys()), loc="lower center", ncol=4, fontsize=8, frameon=False)
+    fig.suptitle(f"relative error against render time (lines: RV = V c / t with 95 % bootstrap band; markers: relMSE "
+                 f"of 1, 2, 4, 8 runs averaged against the reference); {note}", fontsize=9)
+    fig.tight_layout(rect=(0, 0.06, 1, 0.97), h_pad=0.6, w_pad=0.4)
     fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
-def zscore(mu, se, ref_mu, ref_se):
-    den = math.sqrt(se * se + ref_se * ref_se)
-    return (mu - ref_mu) / den if den > 0 else 0.0
+def report(args, P, mode, work, names, results, total, load):
+    out = args.out
+    os.makedirs(out, exist_ok=True)
+    n_tests = sum(len(r["methods"]) for r in results.values())
+    zcrit = common.sidak_z(ALPHA, n_tests)
+    mi_variants = sorted({r["mitsuba"].get("variant") for r in results.values() if r.get("mitsuba")} - {None})
+    mi_note = ("Mitsuba volpath " + "/".join(mi_variants)) if mi_variants else "Mitsuba not run"
 
+    def ratio_cell(r, other):
+        q = r["ratios"].get(other)
+        if not q:
+            return "not run"
+        if r["methods"][other]["mean"] == 0.0:
+            return "∞: its image is black (no such transport)"
+        flag = ""
+        zo = r["methods"][other]["z"]
+        if zo is not None and abs(zo) > zcrit:
+            flag = " †"
+        return f"{fmt(q['ratio'])} [{fmt(q['lo'])}, {fmt(q['hi'])}]{flag}"
 
-def ratio(a, b):
-    """a / b for times to target: inf / finite = inf; finite / inf = 0; inf / inf = nan."""
-    if a is None or b is None or (math.isinf(a) and math.isinf(b)):
-        return float("nan")
-    return a / b if b > 0 else float("nan")
+    def z_cell(r):
+        cells = []
+        for m in ("volpath", "snee", "mitsuba"):
+            s = r["methods"].get(m)
+            if not s:
+                cells.append("–")
+                continue
+            z = s["z"]
+            cells.append("n/a" if z is None else (f"**{z:.1f}**" if abs(z) > zcrit else f"{z:.1f}"))
+        return " / ".join(cells)
 
-
-def fmt_ratio(x):
-    return "inf" if math.isinf(x) else fmt(x)
+    head = ("| configuration | eff. volpath_snee / volpath [95 %] | eff. volpath_snee / Mitsuba volpath [95 %] | "
+            f"bias z vs reference: volpath / snee / Mitsuba (bold: \\|z\\| > {zcrit:.2f}) | "
+            "fireflies per 10⁶ samples: volpath / snee / Mitsuba | reference (error of its mean) | "
+            "relMSE vs ref: volpath / snee / Mitsuba |")
+    lines = [head, "|" + "---|" * 7]
+    for name in names:
+        r = results[name]
+        ref = r["reference"]
+        ff = " / ".join(fmt(r["methods"].get(m, {}).get("firefly_per_1e6"), 2) for m in ("volpath", "snee", "mitsuba"))
+        rm = " / ".join(fmt(r["methods"].get(m, {}).get("relmse"), 2) for m in ("volpath", "snee", "mitsuba"))
+        kind = "sphere → 0 sr" if "sphere" in ref["kind"] else "volpath"
+        lines.append(f"| {name} | {ratio_cell(r, 'volpath')} | {ratio_cell(r, 'mitsuba')} | {z_cell(r)} | {ff} | "
+                     f"{kind}, ±{fmt(100 * ref['se'] / max(abs(ref['mean']), 1e-30) if ref.get('se') is not None else None, 2)} % | {rm} |")
+    table = "\n".join(lines)
+    render_wall = sum(results[n].get("wall_seconds") or 0.0 for n in names)
+    loads = [x for n in names for x in (results[n].get("load_average") or []) if x is not None]
+    summary = (f"mode {mode}: {len(names)} configurations, {P['runs']} runs x {P['run_time']:g} s per method "
+               f"(--threads {args.threads}), references {P['ref_factor']} x {P['run_time']:g} s; rendering wall time "
+               f"{render_wall / 60:.1f} min (all configurations, references included) at a load average of "
+               f"{min(loads, default=0):.1f}-{max(loads, default=0):.1f} (2 cores shared with other jobs); {mi_note}.")
+    verdicts = []
+    for other, label in (("volpath", "snee volpath"), ("mitsuba", "Mitsuba volpath")):
+        black = [n for n in names if results[n]["methods"].get(other, {}).get("mean") == 0.0]
+        q = [results[n]["ratios"].get(other) for n in names if n not in black]
+        q = [x for x in q if x and x.get("lo") is not None and x.get("hi") is not None]
+        win = sum(1 for x in q if x["lo"] > 1)
+        lose = sum(1 for x in q if x["hi"] < 1)
+        verdicts.append(f"volpath_snee vs {label}: more efficient (95 % interval above 1) in {win}, less efficient "
+                        f"(below 1) in {lose}, undecided in {len(q) - win - lose} of {len(q)} configurations where "
+                        f"both render the transport (in {len(black)} more, {label} renders black)")
+    summary += " " + "; ".join(verdicts) + "."
+    cls_lines = []
+    for name in names:
+        for m, c in results[name].get("classes", {}).items():
+            shares = ", ".join(f"{k} {v:.2f}" for k, v in sorted(c["share"].items()))
+            cls_lines.append(f"| {name} | {m} | {shares} | {c['sum_max_rel_diff']:.1e} |")
+    text = [f"<!-- written by scripts/reproduce_figures.py --{mode}; do not edit -->", "", summary, "", table, "",
+            "† the compared method fails the bias test there (it misses transport): its efficiency is that of an "
+            "estimate of a different integral.", ""]
+    if cls_lines:
+        text += ["Variance share per transport class (V_class / V from one extra run at the runs' spp):", "",
+                 "| configuration | method | shares | classes' sum vs image (max rel. diff.) |", "|---|---|---|---|",
+                 *cls_lines, ""]
+    else:
+        text += ["Transport classes: this snee binary has no `--classes`; not measured.", ""]
+    with open(os.path.join(out, "study.md"), "w") as fh:
+        fh.write("\n".join(text))
+    readme = os.path.join(out, "README.md")  # figures/README.md carries the same table between markers
+    if os.path.exists(readme):
+        body = open(readme).read()
+        begin, end = "<!-- study table: written by scripts/reproduce_figures.py", "<!-- /study table -->"
+        i, j = body.find(begin), body.find(end)
+        if 0 <= i < j:
+            i = body.index("\n", i) + 1
+            body = body[:i] + "\n".join(text[2:]) + "\n" + body[j:]
+            with open(readme, "w") as fh:
+                fh.write(body)
+    common.write_json_atomic(os.path.join(out, "study.json"), finite(
+        {"mode": mode, "params": P, "threads": args.threads, "z_threshold_sidak": zcrit, "alpha": ALPHA,
+         "wall_seconds": total, "load_average": load, "mitsuba": mi_note, "results": results}))
+    # Figures from the cached images.
+    fig3, fig4, fig4mi = {}, {}, {}
+    for name in names:
+        light, boundary, ext = name.split("_")
+        with np.load(os.path.join(work, "results", name + ".npz")) as z:
+            key = (ext, light, boundary)
+            e4 = exposure(z["ref"])
+            if "avg_snee" in z.files and "avg_volpath" in z.files:
+                fig4[key] = split(tonemap(z["avg_volpath"], e4), tonemap(z["avg_snee"], e4))
+            if "avg_mitsuba" in z.files:
+                fig4mi[key] = split(tonemap(z["avg_mitsuba"], e4), tonemap(z["avg_snee"], e4))
+            e3 = exposure(z["f3_snee"])
+            fig3[key] = split(tonemap(z["f3_forward"], e3), tonemap(z["f3_snee"], e3))
+    eq = f"{P['runs']} x {P['run_time']:g} s"
+    grid_png(os.path.join(out, "paper_fig3.png"), f"Figure 3: equal samples ({P['fig3_spp']} spp), SNEE's transport "
+             "only - left: volpath (snee=forward), right: volpath_snee (MIS)", fig3,
+             "each tile exposed by the 99th percentile of its SNEE half; sRGB")
+    grid_png(os.path.join(out, "paper_fig4.png"), f"Figure 4: equal time ({eq}, {args.threads} threads), all "
+             "transport - left: volpath, right: volpath_snee", fig4, "exposure from the reference; sRGB")
+    grid_png(os.path.join(out, "paper_fig4_mitsuba.png"), f"Figure 4 against Mitsuba 3: equal time ({eq}) - left: "
+             "Mitsuba volpath, right: snee volpath_snee", fig4mi, f"exposure from the reference; {mi_note}")
+    chart_png(os.path.join(out, "study_error_vs_time.png"), results, P, mi_note)
+    print("\n".join(text))
 
 
 # ----------------------------------------------------------------------------- main
 
-def main():
+def parser():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--quick", action="store_true", help="short renders (about 10-12 minutes)")
-    ap.add_argument("--threads", type=int, default=1,
-                    help="render threads for snee and Mitsuba (default 1: the machine is shared)")
+    size = ap.add_mutually_exclusive_group()
+    size.add_argument("--standard", action="store_true", help="the committed size (default)")
+    size.add_argument("--paper", action="store_true", help="the paper's size, as Ray tasks")
+    size.add_argument("--smoke", action="store_true", help="tiny sizes: checks the pipeline, numbers mean nothing")
+    ap.add_argument("--threads", type=int, default=None, help="render threads per method (default: the mode's)")
     ap.add_argument("--only", default="*", help="glob over configuration names, e.g. 'directional_*'")
-    ap.add_argument("--out", default=os.path.join(ROOT, "figures"))
-    ap.add_argument("--work", default=None, help="render cache (default target/paper_figures/<mode>)")
-    ap.add_argument("--force", action="store_true", help="render again even if cached")
-    ap.add_argument("--no-mitsuba", action="store_true", help="skip Mitsuba 3's volpath (its columns: 'not run')")
-    ap.add_argument("--mitsuba-variant", default="auto", choices=["auto", "llvm_ad_rgb", "scalar_rgb"],
-                    help="auto (default): llvm_ad_rgb if libLLVM loads, else scalar_rgb")
-    ap.add_argument("--mitsuba-worker", metavar="SPEC.json", help=argparse.SUPPRESS)
-    args = ap.parse_args()
-    if args.mitsuba_worker:
-        return mitsuba_worker(args.mitsuba_worker)
-    mode = "quick" if args.quick else "full"
+    ap.add_argument("--out", default=None, help="outputs (default figures/ or figures/paper_size/)")
+    ap.add_argument("--work", default=None, help="render cache (default target/study/<mode>)")
+    ap.add_argument("--force", action="store_true", help="recompute the configurations' results (renders stay cached)")
+    ap.add_argument("--force-renders", action="store_true", help="render everything again")
+    ap.add_argument("--no-mitsuba", action="store_true")
+    ap.add_argument("--mitsuba-variant", default="auto", choices=["auto", "llvm_ad_rgb", "scalar_rgb"])
+    ap.add_argument("--ray", action="store_true", help="run configurations as Ray tasks (default with --paper)")
+    ap.add_argument("--address", default=None, help="Ray cluster to join (auto or HEAD_IP:6379); implies --ray")
+    ap.add_argument("--mitsuba-worker", nargs=3, metavar=("SCENE", "THREADS", "VARIANT"), help=argparse.SUPPRESS)
+    return ap
+
+
+def setup(argv):
+    args = parser().parse_args(argv)
+    mode = "paper" if args.paper else "smoke" if args.smoke else "standard"
     P = MODES[mode]
-    work = os.path.abspath(args.work or os.path.join(ROOT, "target", "paper_figures", mode))
-    os.makedirs(args.out, exist_ok=True)
+    args.mode = mode
+    args.threads = args.threads or P["threads"]
+    args.out = os.path.abspath(args.out or os.path.join(ROOT, "figures", {"standard": "", "paper": "paper_size", "smoke": "smoke"}[mode]))
+    args.classes = common.snee_supports(SNEE, "--classes")
+    work = os.path.abspath(args.work or os.path.join(ROOT, "target", "study", mode))
+    return args, P, work
+
+
+def main():
+    argv = sys.argv[1:]
+    args, P, work = setup(argv)
+    if args.mitsuba_worker:
+        scene, threads, variant = args.mitsuba_worker
+        return mitsuba_worker(scene, int(threads), variant)
     if not os.path.exists(SNEE):
         sys.exit(f"{SNEE} not found: run `cargo build --release` first")
-
     names = [n for n in configs() if fnmatch.fnmatch(n, args.only)]
-    t_start = time.time()
-    results, fig3, fig4, fig4mi = {}, {}, {}, {}
-    cum_times = [float(t) for t in np.cumsum(P["series"])]
-    mi_status = "not run (--no-mitsuba)" if args.no_mitsuba else None
-    mi_variants = set()
-    print(f"mode {mode}: {len(names)} configurations, Figure 3 at {P['fig3_spp']} spp, series {P['series']} s, "
-          f"reference 2 x {P['ref_time']:g} s, --threads {args.threads}, Mitsuba: "
-          f"{mi_status or 'volpath, variant ' + args.mitsuba_variant}", flush=True)
-    for k, name in enumerate(names):
-        light, boundary, ext = name.split("_")
-        # Reference: two independent halves.
-        halves = []
-        for h in range(2):
-            est = Estimate()
-            est.add(*render(args, work, name, "snee", f"ref{h}", seed=1000 + h, seconds=P["ref_time"]))
-            halves.append(est)
-        ref = Estimate()
-        for h in halves:
-            ref.sum = h.sum if ref.sum is None else ref.sum + h.sum
-            ref.sum_m2 = h.sum_m2 if ref.sum_m2 is None else ref.sum_m2 + h.sum_m2
-            ref.spp += h.spp
-            ref.seconds += h.seconds
-        ref_img = ref.mean
-        floor = rel_mse(halves[0].mean, halves[1].mean) / 4.0
-        ref_mu, ref_se = ref.mean_and_se()
-        res = {"ref_spp": ref.spp, "ref_seconds": ref.seconds, "ref_floor": floor, "ref_mean": ref_mu}
-
-        # Equal-time series, snee's methods interleaved so that they see similar machine load.
-        ests = {"volpath": Estimate(), "snee": Estimate()}
-        for m in ests:
-            res[m] = {"times": [], "relmse": [], "spp": []}
-        for i, target in enumerate(cum_times):
-            for m in ("volpath", "snee"):
-                seed = 10 * i + (1 if m == "snee" else 2)
-                if i == 0:  # the timed probe
-                    run = render(args, work, name, m, f"t{i}", seed=seed, seconds=P["series"][0])
-                else:  # spp from the measured rate, so the cumulative time tracks the target
-                    rate = ests[m].spp / ests[m].seconds
-                    spp = max(1, int(round(rate * (target - ests[m].seconds))))
-                    run = render(args, work, name, m, f"t{i}", seed=seed, spp=spp)
-                ests[m].add(*run)
-                res[m]["times"].append(ests[m].seconds)
-                res[m]["relmse"].append(rel_mse(ests[m].mean, ref_img))
-                res[m]["spp"].append(ests[m].spp)
-        for m, est in ests.items():
-            c, s = fit_power(res[m]["times"], res[m]["relmse"])
-            mu, se = est.mean_and_se()
-            res[m].update(fit_c=c, fit_slope=s, time_to_target=time_to(c, s, TARGET), mean=mu,
-                          z_vs_ref=zscore(mu, se, ref_mu, ref_se),
-                          final_relmse=res[m]["relmse"][-1], final_time=res[m]["times"][-1])
-
-        # Mitsuba 3's volpath at equal time, in a subprocess.
-        mi_est = None
-        if mi_status is None:
-            mr = mitsuba_series(args, work, name, P["series"])
-            if mr["status"] == "not installed":
-                mi_status = "not run (the mitsuba Python package is not installed)"
-                print(f"warning: Mitsuba columns not run: {mr.get('detail', '')}", file=sys.stderr)
-            elif mr["status"] != "ok":
-                res["mitsuba"] = {"status": mr["status"]}
-            else:
-                info = mr["result"]
-                if info["variant_notes"] and info["variant"] not in mi_variants:
-                    print(f"warning: Mitsuba uses {info['variant']}: {'; '.join(info['variant_notes'])}",
-                          file=sys.stderr)
-                mi_variants.add(info["variant"])
-                mi_est = MitsubaEstimate()
-                rm = {"status": "ok", "variant": info["variant"], "variant_notes": info["variant_notes"],
-                      "thread_count": info["thread_count"], "load_seconds": info["load_seconds"],
-                      "warmup": info["warmup"], "probe": info["probe"], "runs": info["runs"],
-                      "times": [], "relmse": [], "spp": []}
-                for i, r in enumerate(info["runs"]):
-                    a = mr["arrays"]
-                    mi_est.add(a[f"rgb{i}"], a[f"y{i}"], a[f"m2y{i}"], r["spp"], r["seconds"])
-                    rm["times"].append(mi_est.seconds)
-                    rm["relmse"].append(rel_mse(mi_est.mean, ref_img))
-                    rm["spp"].append(mi_est.spp)
-                c, s = fit_power(rm["times"], rm["relmse"])
-                mu, se = mi_est.y_mean_and_se()
-                ref_y, ref_y_se = y_mean_and_se_bound(ref)
-                busy = sum(r["cpu_seconds"] - r["compile_seconds"] for r in info["runs"]) / mi_est.seconds
-                rm.update(fit_c=c, fit_slope=s, time_to_target=time_to(c, s, TARGET), mean_y=mu, ref_mean_y=ref_y,
-                          z_vs_ref=zscore(mu, se, ref_y, ref_y_se), cpu_per_second=busy,
-                          final_relmse=rm["relmse"][-1], final_time=rm["times"][-1])
-                if busy > 1.15 * args.threads:
-                    print(f"warning: Mitsuba used {busy:.2f} CPU seconds per second, more than --threads "
-                          f"{args.threads}", file=sys.stderr)
-                res["mitsuba"] = rm
-        if mi_status is not None:
-            res["mitsuba"] = {"status": mi_status}
-
-        # Figure 3: equal samples, SNEE's transport only.
-        f3 = {}
-        for v in ("fig3_forward", "fig3_snee"):
-            est = Estimate()
-            est.add(*render(args, work, name, v, "f3", seed=7, spp=P["fig3_spp"]))
-            f3[v] = est
-        (mf, sf), (ms, ss) = f3["fig3_forward"].mean_and_se(), f3["fig3_snee"].mean_and_se()
-        res["fig3"] = {"forward_mean": mf, "snee_mean": ms, "z_forward_vs_snee": zscore(mf, sf, ms, ss),
-                       "forward_seconds": f3["fig3_forward"].seconds, "snee_seconds": f3["fig3_snee"].seconds}
-        results[name] = res
-
-        # Images (exposure from the reference for Figure 4, from SNEE's image for Figure 3).
-        key = (ext, light, boundary)
-        e4 = exposure(ref_img)
-        snee_tile = tonemap(ests["snee"].mean, e4)
-        fig4[key] = split(tonemap(ests["volpath"].mean, e4), snee_tile)
-        if mi_est is not None:
-            fig4mi[key] = split(tonemap(mi_est.mean, e4), snee_tile)
-        e3 = exposure(f3["fig3_snee"].mean)
-        fig3[key] = split(tonemap(f3["fig3_forward"].mean, e3), tonemap(f3["fig3_snee"].mean, e3))
-        vp, sn, mr = res["volpath"], res["snee"], res["mitsuba"]
-        mi_text = (f"Mitsuba@{mr['final_time']:.2f}s {mr['final_relmse']:.3g} (z {mr['z_vs_ref']:.1f}, "
-                   f"{mr['variant']}, {mr['spp'][-1]} spp)" if mr["status"] == "ok" else f"Mitsuba {mr['status']}")
-        print(f"[{k + 1}/{len(names)}] {name}: relMSE volpath@{vp['final_time']:.2f}s {vp['final_relmse']:.3g}, "
-              f"snee@{sn['final_time']:.2f}s {sn['final_relmse']:.3g}, {mi_text}, floor {floor:.2g}; "
-              f"z(mean vs ref) volpath {vp['z_vs_ref']:.1f} snee {sn['z_vs_ref']:.1f}; "
-              f"fig3 z(forward vs snee) {res['fig3']['z_forward_vs_snee']:.1f}  "
-              f"[{time.time() - t_start:.0f} s]", flush=True)
-
-    total = time.time() - t_start
-    if mi_status is None:
-        mi_status = "variant " + "/".join(sorted(mi_variants)) if mi_variants else "failed"
-    mi_note = f"Mitsuba volpath: {mi_status}"
-    # ------------------------------------------------------------------ outputs
-    grid_png(os.path.join(args.out, "paper_fig3.png"),
-             f"Figure 3: equal samples ({P['fig3_spp']} spp), SNEE's transport only - left: volpath (snee=forward), "
-             f"right: volpath_snee (MIS)", fig3,
-             "each tile exposed by the 99th percentile of its SNEE half; sRGB")
-    grid_png(os.path.join(args.out, "paper_fig4.png"),
-             f"Figure 4: equal time ({cum_times[-1]:g} s render, {args.threads} thread(s)), all transport - "
-             f"left: volpath, right: volpath_snee (MIS)", fig4,
-             "each tile exposed by the 99th percentile of its reference; sRGB")
-    grid_png(os.path.join(args.out, "paper_fig4_mitsuba.png"),
-             f"Figure 4 against Mitsuba 3: equal time ({cum_times[-1]:g} s render, {args.threads} thread(s)), "
-             f"all transport - left: Mitsuba volpath, right: snee volpath_snee (MIS)", fig4mi,
-             f"each tile exposed by the 99th percentile of its reference; sRGB; {mi_note}")
-    chart_png(os.path.join(args.out, "paper_relmse_vs_time.png"), results, mode, cum_times, mi_note)
-
-    head = ("| configuration | volpath relMSE | volpath_snee relMSE | Mitsuba volpath relMSE | "
-            "time (vp / snee / Mitsuba) [s] | ref floor | SNEE eff. ratio | eff. ratio (floor subtracted) | "
-            f"SNEE eff. ratio vs Mitsuba | t to relMSE {TARGET:g}: volpath / snee / Mitsuba [s] | "
-            "t ratio Mitsuba / snee | fit slopes (vp / snee / Mitsuba) | z mean vs ref (vp / snee / Mitsuba Y) | "
-            "Fig.3 z (fwd vs snee) |")
-    lines = [head, "|" + "---|" * (head.count("|") - 1)]
-    for name in names:
-        r = results[name]
-        vp, sn, mr = r["volpath"], r["snee"], r["mitsuba"]
-        eff = (vp["final_relmse"] * vp["final_time"]) / (sn["final_relmse"] * sn["final_time"])
-        dv, ds = vp["final_relmse"] - r["ref_floor"], sn["final_relmse"] - r["ref_floor"]
-        effc = (dv * vp["final_time"]) / (ds * sn["final_time"]) if dv > 0 and ds > 0 else float("nan")
-        r["eff_ratio"], r["eff_ratio_floor"] = eff, effc
-        if mr["status"] == "ok":
-            r["eff_ratio_mitsuba"] = (mr["final_relmse"] * mr["final_time"]) / (sn["final_relmse"] * sn["final_time"])
-            r["t_target_ratio_mitsuba"] = ratio(mr["time_to_target"], sn["time_to_target"])
-            mi_cells = (fmt(mr["final_relmse"]), f"{mr['final_time']:.2f}", fmt(r["eff_ratio_mitsuba"]),
-                        fmt(mr["time_to_target"]), fmt_ratio(r["t_target_ratio_mitsuba"]), f"{mr['fit_slope']:.2f}",
-                        f"{mr['z_vs_ref']:.1f}")
-        else:
-            cell = "failed" if mr["status"].startswith("failed") else "not run"
-            mi_cells = (cell, "-", cell, "-", "-", "-", "-")
-        lines.append(
-            f"| {name} | {fmt(vp['final_relmse'])} | {fmt(sn['final_relmse'])} | {mi_cells[0]} | "
-            f"{vp['final_time']:.2f} / {sn['final_time']:.2f} / {mi_cells[1]} | {fmt(r['ref_floor'], 2)} | "
-            f"{fmt(eff)} | {fmt(effc)} | {mi_cells[2]} | "
-            f"{fmt(vp['time_to_target'])} / {fmt(sn['time_to_target'])} / {mi_cells[3]} | {mi_cells[4]} | "
-            f"{vp['fit_slope']:.2f} / {sn['fit_slope']:.2f} / {mi_cells[5]} | "
-            f"{vp['z_vs_ref']:.1f} / {sn['z_vs_ref']:.1f} / {mi_cells[6]} | "
-            f"{r['fig3']['z_forward_vs_snee']:.1f} |")
-    table = "\n".join(lines)
-    summary = (f"mode {mode}; {len(names)} configurations; wall time {total:.0f} s; reference per configuration: "
-               f"volpath_snee 2 x {P['ref_time']:g} s; equal time {cum_times[-1]:g} s; Figure 3 {P['fig3_spp']} spp; "
-               f"--threads {args.threads}; {mi_note}")
-    print()
-    print(table)
-    print()
-    print(summary)
-    with open(os.path.join(args.out, "paper_results.md"), "w") as fh:
-        fh.write(f"<!-- written by scripts/reproduce_figures.py {'--quick' if args.quick else ''} -->\n{summary}\n\n{table}\n")
-    with open(os.path.join(args.out, "paper_results.json"), "w") as fh:
-        json.dump(finite({"mode": mode, "params": P, "target": TARGET, "threads": args.threads, "mitsuba": mi_note,
-                          "wall_seconds": total, "results": results}), fh, indent=1)
+    t0, load0 = time.time(), os.getloadavg()[0]
+    print(f"mode {args.mode}: {len(names)} configurations, {P['runs']} runs x {P['run_time']:g} s, reference "
+          f"{P['ref_factor']} x, --threads {args.threads}, transport classes: "
+          f"{'yes' if args.classes else 'not in this binary'}; load average {load0:.2f}", flush=True)
+    results = {}
+    if args.ray or args.paper or args.address:
+        import ray
+        ray.init(address=args.address or "local", include_dashboard=False, log_to_driver=False,
+                 runtime_env={"env_vars": {"PYTHONPATH": os.path.dirname(os.path.abspath(__file__))}})
+        try:
+            task = ray.remote(run_config_task).options(num_cpus=args.threads, max_retries=3, retry_exceptions=False)
+            pending = {task.remote(argv, n): n for n in names}
+            while pending:
+                ready, _ = ray.wait(list(pending), num_returns=1)
+                for r in ready:
+                    results[pending.pop(r)] = ray.get(r)
+                    sys.stderr.write(f"\r{len(results)}/{len(names)} configurations  {time.time() - t0:7.0f} s")
+            sys.stderr.write("\n")
+        finally:
+            ray.shutdown()
+    else:
+        for k, name in enumerate(names):
+            r = run_config(args, P, work, name)
+            results[name] = r
+            q = r["ratios"]
+            print(f"[{k + 1}/{len(names)}] {name}: eff snee/volpath "
+                  f"{fmt(q.get('volpath', {}).get('ratio'))} [{fmt(q.get('volpath', {}).get('lo'))}, "
+                  f"{fmt(q.get('volpath', {}).get('hi'))}], snee/Mitsuba {fmt(q.get('mitsuba', {}).get('ratio'))}; "
+                  f"z " + " / ".join(fmt(s['z'], 2) for s in r["methods"].values()) +
+                  f"; {r['wall_seconds']:.0f} s, load {r['load_average'][1]:.2f}  [{time.time() - t0:.0f} s]", flush=True)
+    report(args, P, args.mode, work, names, results, time.time() - t0, [load0, os.getloadavg()[0]])
     return 0
 
 
