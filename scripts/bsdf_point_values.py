@@ -24,14 +24,12 @@ a string, a boolean, a 3-list (an <rgb>), or {"bsdf": configuration} for a neste
 Usage: python3 scripts/bsdf_point_values.py [--help]
 """
 import argparse
-import json
 import math
-import os
 import random
 
 import mitsuba as mi
 
-ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import common
 
 
 def to_mitsuba(cfg):
@@ -124,7 +122,7 @@ def vec(v):
 
 def f9(x):
     """A float rounded to 9 significant digits (what the tests read as f32, round-trip exact)."""
-    return float("%.9g" % float(x))
+    return common.rounded(x, 9)
 
 
 def v9(v):
@@ -213,18 +211,11 @@ def dielectric_diffuse_cases():
             "smooth": smooth, "diffuse": diffuse}
 
 
-def write_json(name, data):
-    path = os.path.join(ROOT, "tests", "data", name)
-    with open(path, "w") as fh:
-        json.dump(data, fh, separators=(",", ":"))
-    return path
-
-
 def main():
     argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
-    mi.set_variant("scalar_rgb")
+    common.setup_mitsuba("scalar_rgb")
     data = dielectric_diffuse_cases()
-    path = write_json("bsdf_dielectric_diffuse.json", data)
+    path = common.write_test_json("bsdf_dielectric_diffuse.json", data)
     print("wrote %s (%d + %d + %d cases)" % (path, len(data["rough_dielectric"]), len(data["smooth"]),
                                              len(data["diffuse"])))
     surface_cases()
@@ -268,7 +259,7 @@ def surface_cases():
                         "null_transmission": vec(b.eval_null_transmission(si)),
                     })
         result["configs"].append({"config": cfg, "flags": [int(b.flags(i)) for i in range(ncomp)], "cases": cases})
-    path = write_json("bsdf_surfaces.json", result)
+    path = common.write_test_json("bsdf_surfaces.json", result)
     print("wrote %s (%d configurations)" % (path, len(result["configs"])))
 
 

@@ -12,9 +12,9 @@ Usage: python3 scripts/conductor_materials.py   (rewrites src/bsdf/conductor_mat
 """
 import os
 
-import mitsuba as mi
+import common
 
-ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+ROOT = common.ROOT
 # The presets shipped with Mitsuba 3 (data/ios/*.spd), as named in its conductor documentation.
 NAMES = ["a-C", "Ag", "Al", "AlAs", "AlAs_palik", "AlSb", "AlSb_palik", "Au", "Be", "Be_palik", "Cr", "CsI",
          "CsI_palik", "Cu", "Cu_palik", "Cu2O", "Cu2O_palik", "CuO", "CuO_palik", "d-C", "d-C_palik", "Hg",
@@ -31,7 +31,7 @@ def f(x):
 
 
 def main():
-    mi.set_variant("scalar_rgb")
+    mi, _ = common.setup_mitsuba("scalar_rgb")
     rows = []
     for name in NAMES:
         try:

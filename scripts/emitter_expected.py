@@ -9,19 +9,19 @@ direction towards the emitter, "ref" a reference point, matrices are row-major a
 Requires: mitsuba (3.9), numpy, pillow.   Usage: python3 scripts/emitter_expected.py [--help]
 """
 import argparse
-import json
 import math
 import os
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-DATA = os.path.join(ROOT, "tests", "data")
+import common
+
+DATA = common.TEST_DATA
 
 
 def num(x):
     """A number as the tests read it: 10 significant digits (round-trip exact for f32)."""
-    return float(f"{float(x):.9e}")
+    return common.rounded(x, 10)
 
 
 def vec(v):
@@ -189,17 +189,12 @@ def texture_values(mi):
 
 def main():
     argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
-    import mitsuba as mi
-
-    mi.set_variant("scalar_rgb")
+    mi, _ = common.setup_mitsuba("scalar_rgb")
     make_images(mi)
     print(f"wrote images to {DATA}")
     for name, values in [("emitters.json", emitter_values(mi)), ("textures.json", texture_values(mi))]:
         values = {"mitsuba_version": mi.__version__, "variant": "scalar_rgb", **values}
-        path = os.path.join(DATA, name)
-        with open(path, "w") as fh:
-            json.dump(values, fh, indent=1)
-        print(f"wrote {path}")
+        print(f"wrote {common.write_test_json(name, values, indent=1)}")
 
 
 if __name__ == "__main__":

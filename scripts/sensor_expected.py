@@ -14,11 +14,10 @@ Numbers keep 10 significant digits (8 for the image blocks).
 Usage: python3 scripts/sensor_expected.py            (needs `pip install mitsuba==3.9.1`)
 """
 import argparse
-import json
-import os
 
-os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1")
-import mitsuba as mi  # noqa: E402
+import common
+
+mi = None  # the mitsuba module, set in main()
 
 CONFIGS = [
     # name, sensor parameters (besides film and to_world), film (w, h, crop), look_at (origin, target, up) or None
@@ -39,9 +38,9 @@ CONFIGS = [
 SAMPLES = [(0.5, 0.5), (0.0, 0.0), (1.0, 1.0), (0.25, 0.8), (0.9, 0.1)]
 
 
-def num(x, digits=9):
-    """A number rounded as the tests read it: `digits` + 1 significant digits."""
-    return float(f"{float(x):.{digits}e}")
+def num(x, digits=10):
+    """A number rounded as the tests read it: `digits` significant digits."""
+    return common.rounded(x, digits)
 
 
 def vec(v):
@@ -96,7 +95,7 @@ def image_blocks():
     """Splat BLOCK_SAMPLES with Mitsuba's ImageBlock as the llvm variants render (eval, no table):
     per filter the weights and the developed values of the interior pixels, row-major."""
     import numpy as np
-    mi.set_variant("llvm_ad_rgb")
+    common.setup_mitsuba("llvm_ad_rgb")
     xs, ys, vs = (mi.Float([s[i] for s in BLOCK_SAMPLES]) for i in range(3))
     blocks = []
     for d in [FILTERS[0], FILTERS[4], FILTERS[2], FILTERS[5]]:
@@ -107,7 +106,7 @@ def image_blocks():
         t = np.array(b.tensor())
         w = t[:, :, 1].ravel()
         v = np.where(w != 0, t[:, :, 0].ravel() / np.where(w != 0, w, 1), 0)
-        blocks.append({"filter": d, "weights": [num(x, 7) for x in w], "values": [num(x, 7) for x in v]})
+        blocks.append({"filter": d, "weights": [num(x, 8) for x in w], "values": [num(x, 8) for x in v]})
     return {"offset": BLOCK_OFFSET, "size": BLOCK_SIZE, "samples": BLOCK_SAMPLES, "blocks": blocks}
 
 
@@ -115,13 +114,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (default scalar_rgb)")
     args = ap.parse_args()
-    mi.set_variant(args.variant)
+    global mi
+    mi, _ = common.setup_mitsuba(args.variant)
     out = {"mitsuba_version": mi.__version__, "variant": args.variant, "cameras": cameras(), "filters": filters()}
     out["image_block"] = {"variant": "llvm_ad_rgb", **image_blocks()}
-    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tests", "data", "sensor.json")
-    with open(path, "w") as fh:
-        json.dump(out, fh, indent=1)
-    print(f"wrote {path}")
+    print(f"wrote {common.write_test_json('sensor.json', out, indent=1)}")
 
 
 if __name__ == "__main__":
