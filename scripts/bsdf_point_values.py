@@ -1,16 +1,16 @@
 #!/usr/bin/env python3
-"""Point values of Mitsuba 3.9.1's BSDFs for the BSDF tests (tests/bsdf/).
+"""Point values of Mitsuba 3.9.1's BSDFs for the BSDF tests (tests/plugins/bsdf.rs, bsdf_surfaces.rs).
 
 Writes two files into tests/data/ (variant `scalar_rgb`, both seeded, so they are reproducible):
 
-bsdf_dielectric_diffuse.json, for tests/bsdf/chi2.rs: `roughdielectric` over distributions,
+bsdf_dielectric_diffuse.json, for tests/plugins/bsdf.rs: `roughdielectric` over distributions,
 roughnesses, IORs and sampling modes (a sample and eval_pdf at three directions each), the smooth
 models `dielectric`, `thindielectric`, `null` (a sample per context and eval_null_transmission), and
 `diffuse` / `twosided(diffuse)` (a sample and eval_pdf). Numbers are rounded to 9 significant digits
 (round-trip exact for f32).
 
-bsdf_surfaces.json, for tests/bsdf/surfaces.rs: for every configuration of `conductor`, `roughconductor`,
-`plastic`, `roughplastic` and `mask` below, a few incident directions, and for each
+bsdf_surfaces.json, for tests/plugins/bsdf_surfaces.rs: for every configuration of `conductor`,
+`roughconductor`, `plastic`, `roughplastic` and `mask` below, a few incident directions, and for each
   - Mitsuba's `sample(ctx, si, sample1, sample2)`: wo, pdf, weight (RGB), sampled type/component;
   - `eval_pdf` (and `eval`, `pdf` alone, which must agree) at the sampled wo and at independent
     directions (some below the surface);
@@ -130,7 +130,7 @@ def v9(v):
 
 
 def dielectric_diffuse_cases():
-    """roughdielectric, the smooth models and diffuse/twosided: the tables of tests/bsdf/chi2.rs."""
+    """roughdielectric, the smooth models and diffuse/twosided: the tables of tests/plugins/bsdf.rs."""
     rng = random.Random(12345)
     rough = []
     for dist in ["beckmann", "ggx"]:

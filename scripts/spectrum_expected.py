@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Expected linear sRGB of <spectrum value="wavelength:value ..."> for tests/xml_parse.rs.
+"""Expected linear sRGB of <spectrum value="wavelength:value ..."> for tests/xml/parse.rs.
 
 Loads scenes with Mitsuba 3 in the scalar_rgb variant and reads back the colour the plugins
 received: a diffuse reflectance (weighted by D65, clamped to [0, 1]) and an area emitter's

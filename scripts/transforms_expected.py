@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Expected <transform> matrices for tests/xml_parse.rs, computed with Mitsuba 3.
+"""Expected <transform> matrices for tests/xml/parse.rs, computed with Mitsuba 3.
 
 For each case the matrix is taken from Mitsuba's own XML parser (mi.parser.parse_string) and,
 independently, composed from mi.ScalarAffineTransform4d operations (each op multiplies from the

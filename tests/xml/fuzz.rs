@@ -238,5 +238,5 @@ fn mutated_scenes_never_panic() {
         })
         .unwrap();
     let (oks, errors) = (oks.get(), errors.get());
-    eprintln!("fuzz_xml: {} inputs, {oks} parsed, {errors} rejected with an error", oks + errors);
+    eprintln!("xml fuzz: {} inputs, {oks} parsed, {errors} rejected with an error", oks + errors);
 }
