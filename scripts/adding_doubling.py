@@ -48,7 +48,8 @@ import warnings
 
 import numpy as np
 
-ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import common
+
 ALBEDOS = [0.3, 0.8, 0.95, 0.99]
 GS = [0.0, 0.5, -0.3, 0.9]
 NS = [1.0, 1.33, 1.5]
@@ -85,7 +86,7 @@ def chandrasekhar_h1(a, nodes=400, iters=2000):
 def main():
     ap = argparse.ArgumentParser(description="Adding-doubling (iadpython) total reflectance of a "
                                              "semi-infinite slab under a normal collimated beam.")
-    ap.add_argument("--out", default=os.path.join(ROOT, "tests", "data", "adding_doubling.json"),
+    ap.add_argument("--out", default=os.path.join(common.TEST_DATA, "adding_doubling.json"),
                     help="output JSON (default: tests/data/adding_doubling.json)")
     args = ap.parse_args()
 

@@ -47,10 +47,8 @@ import time
 
 import numpy as np
 
-ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-LLVM_CANDIDATES = ["/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so",
-                   "/usr/lib/x86_64-linux-gnu/libLLVM-15.so", "/usr/lib/x86_64-linux-gnu/libLLVM-14.so"]
-MAX_SAMPLES_PER_PASS = 1 << 22
+import common
+from common import MAX_SAMPLES_PER_PASS, ROOT
 
 
 def run_snee(args, scene, out_dir):
@@ -89,22 +87,6 @@ def run_snee(args, scene, out_dir):
         print(f"warning: snee rendered {stats['spp']} spp, asked for {args.spp}", file=sys.stderr)
     return dict(seconds=float(stats["seconds"]), wall_seconds=wall, spp=int(stats["spp"]),
                 samples_per_second=float(stats["samples_per_second"]), image=exr, stats=stats)
-
-
-def setup_mitsuba(variant):
-    if "llvm" in variant and "DRJIT_LIBLLVM_PATH" not in os.environ:
-        for cand in LLVM_CANDIDATES:
-            if os.path.exists(cand):
-                os.environ["DRJIT_LIBLLVM_PATH"] = cand
-                break
-    import mitsuba as mi
-    try:
-        mi.set_variant(variant)
-    except Exception as err:  # noqa: BLE001 - no LLVM: fall back
-        print(f"warning: variant {variant} unavailable ({err}); using scalar_rgb", file=sys.stderr)
-        variant = "scalar_rgb"
-        mi.set_variant(variant)
-    return mi, variant
 
 
 def mitsuba_render(mi, scene, spp, seed):
@@ -150,11 +132,10 @@ def run_mitsuba(args, mi, variant, scene_path, out_dir):
 
 
 def mean_rgb(mi, path):
-    bmp = mi.Bitmap(path)
-    names = [bmp.struct_()[i].name for i in range(bmp.channel_count())]
-    arr = np.array(bmp, dtype=np.float64)
-    idx = [names.index(c) for c in ("R", "G", "B")] if all(c in names for c in "RGB") else [0, 1, 2]
-    return arr[..., idx].mean(axis=(0, 1))
+    ch = common.bitmap_channels(mi, path)
+    if not all(c in ch for c in "RGB"):  # unnamed channels: the first three
+        ch = dict(zip("RGB", list(ch.values())[:3]))
+    return common.rgb(ch).mean(axis=(0, 1))
 
 
 def bench_scene(args, mi, variant, scene):
@@ -301,7 +282,7 @@ def main():
         print("building snee (cargo build --release, not timed) ...", flush=True)
         subprocess.run(["cargo", "build", "--release"], cwd=ROOT, check=True)
         args.snee = os.path.join(ROOT, "target", "release", "snee")
-    mi, variant = setup_mitsuba(args.variant)
+    mi, variant = common.setup_mitsuba(args.variant)
     base_defines = [tuple(d.split("=", 1)) for d in args.define]
     results = []
     for scene, integrator, spp in jobs:

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Reference values from Mitsuba 3 for snee's emitter and texture tests.
 
-Writes the small test images into tests/data/ and prints, for each case, the inputs and Mitsuba's
-outputs as Rust array literals; the tests in tests/chi2_emitters.rs and tests/textures.rs hold
-these numbers (with the snippet that produced them in comments).
+Writes the small test images into tests/data/ and, for each case, the inputs and Mitsuba's outputs
+(rounded to 10 significant digits) into tests/data/emitters.json (read by the emitter tests) and
+tests/data/textures.json (read by the texture tests). Each table's key names what it holds; "d" is a
+direction towards the emitter, "ref" a reference point, matrices are row-major as Mitsuba prints them.
 
 Requires: mitsuba (3.9), numpy, pillow.   Usage: python3 scripts/emitter_expected.py [--help]
 """
@@ -13,17 +14,23 @@ import os
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-DATA = os.path.join(ROOT, "tests", "data")
+import common
+
+DATA = common.TEST_DATA
 
 
-def fmt(v):
-    return "[" + ", ".join(f"{float(x):.9e}" for x in v) + "]"
+def num(x):
+    """A number as the tests read it: 10 significant digits (round-trip exact for f32)."""
+    return common.rounded(x, 10)
+
+
+def vec(v):
+    return [num(x) for x in v]
 
 
 def mat_rows(t):
     m = np.array(t.matrix, dtype=np.float64)
-    return "[" + ", ".join(fmt(m[i]) for i in range(4)) + "]"
+    return [vec(m[i]) for i in range(4)]
 
 
 def make_images(mi):
@@ -60,47 +67,37 @@ def make_images(mi):
     return env, a
 
 
-def main():
-    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
-    import mitsuba as mi
-
-    mi.set_variant("scalar_rgb")
-    make_images(mi)
-    print(f"// wrote images to {DATA}")
-
-    # ---- envmap eval ----
+def emitter_values(mi):
+    out = {}
+    # ---- envmap eval: envmap_half_piz.exr, scale 1.5, to_world = rotate(y, 30) . rotate(x, 20) ----
     to_world = mi.ScalarTransform4f().rotate([0, 1, 0], 30).rotate([1, 0, 0], 20)
     dirs = [[0, 0, 1], [0, 1, 0], [1, 0, 0], [-0.3, 0.5, 0.8], [0.6, -0.7, 0.2], [0.1, 0.95, -0.2],
             [-0.9, 0.1, -0.3], [0.2, -0.1, -0.97], [0.35, 0.82, 0.41]]
     dirs = [list(np.array(d) / np.linalg.norm(d)) for d in dirs]
     env = mi.load_dict({"type": "envmap", "filename": os.path.join(DATA, "envmap_half_piz.exr"),
                         "scale": 1.5, "to_world": to_world})
-    print("// envmap_half_piz.exr, scale 1.5, to_world = rotate(y, 30) . rotate(x, 20)")
-    print("const ENV_TO_WORLD: [[f64; 4]; 4] =", mat_rows(to_world) + ";")
-    print("const ENV_EVAL: &[([f32; 3], [f32; 3])] = &[")
+    out["env_to_world"] = mat_rows(to_world)
+    out["env_eval"] = []
     for d in dirs:
         si = mi.SurfaceInteraction3f()
         si.wi = -mi.Vector3f(d)
-        print(f"    ({fmt(d)}, {fmt(env.eval(si))}),")
-    print("];")
-    env_png = mi.load_dict({"type": "envmap", "filename": os.path.join(DATA, "tex_rgb8.png")})
+        out["env_eval"].append({"d": vec(d), "value": vec(env.eval(si))})
+    # tex_rgb8.png as an envmap (sRGB -> linear), identity transform.
     # (Not straight up: at the pole u depends on the sign of a zero in Mitsuba's arithmetic.)
-    print("// tex_rgb8.png as an envmap (sRGB -> linear), identity transform")
-    print("const ENV_PNG_EVAL: &[([f32; 3], [f32; 3])] = &[")
+    env_png = mi.load_dict({"type": "envmap", "filename": os.path.join(DATA, "tex_rgb8.png")})
+    out["env_png_eval"] = []
     for d in [dirs[0]] + dirs[2:6]:
         si = mi.SurfaceInteraction3f()
         si.wi = -mi.Vector3f(d)
-        print(f"    ({fmt(d)}, {fmt(env_png.eval(si))}),")
-    print("];")
+        out["env_png_eval"].append({"d": vec(d), "value": vec(env_png.eval(si))})
 
-    # ---- spot ----
+    # ---- spot: cutoff 30, beam 12, intensity (2,3,4), to_world = look_at([1,2,3] -> [1,0,3.5], up z) ----
     spot_to_world = mi.ScalarTransform4f().look_at(origin=[1, 2, 3], target=[1, 0, 3.5], up=[0, 0, 1])
     spot = mi.load_dict({"type": "spot", "cutoff_angle": 30.0, "beam_width": 12.0, "to_world": spot_to_world,
                          "intensity": mi.ScalarColor3f(2.0, 3.0, 4.0)})
     spot_default = mi.load_dict({"type": "spot"})
-    print("// spot: cutoff 30, beam 12, intensity (2,3,4), to_world = look_at([1,2,3] -> [1,0,3.5], up z)")
-    print("const SPOT_TO_WORLD: [[f64; 4]; 4] =", mat_rows(spot_to_world) + ";")
-    print("const SPOT_WEIGHT: &[([f32; 3], [f32; 3])] = &[")
+    out["spot_to_world"] = mat_rows(spot_to_world)
+    out["spot_weight"] = []
     for ang in [0, 5, 11.9, 12.5, 15, 20, 25, 29.5, 31, 60]:
         for phi in [0.0, 1.3]:
             a, p = math.radians(ang), phi
@@ -111,23 +108,20 @@ def main():
             it = mi.Interaction3f()
             it.p = mi.Point3f(ref)
             ds, wgt = spot.sample_direction(it, mi.Point2f(0.5, 0.5))
-            print(f"    ({fmt(ref)}, {fmt(wgt)}),")
-    print("];")
-    print("// spot with defaults (cutoff 20, beam 15) at the origin, along +z; reference points")
-    print("const SPOT_DEFAULT_WEIGHT: &[([f32; 3], [f32; 3])] = &[")
+            out["spot_weight"].append({"ref": vec(ref), "weight": vec(wgt)})
+    # spot with defaults (cutoff 20, beam 15) at the origin, along +z
+    out["spot_default_weight"] = []
     for ang in [0, 10, 14.9, 16, 18, 19.9, 21]:
         a = math.radians(ang)
         ref = 2.0 * np.array([math.sin(a), 0, math.cos(a)])
         it = mi.Interaction3f()
         it.p = mi.Point3f(ref)
         ds, wgt = spot_default.sample_direction(it, mi.Point2f(0.5, 0.5))
-        print(f"    ({fmt(ref)}, {fmt(wgt)}),")
-    print("];")
-
+        out["spot_default_weight"].append({"ref": vec(ref), "weight": vec(wgt)})
+    # spot: cutoff 40 (beam 30), texture tex_rgb8.png, to_world = spot_to_world
     spot_tex = mi.load_dict({"type": "spot", "cutoff_angle": 40.0, "to_world": spot_to_world,
                              "texture": {"type": "bitmap", "filename": os.path.join(DATA, "tex_rgb8.png")}})
-    print("// spot: cutoff 40 (beam 30), texture tex_rgb8.png, to_world = SPOT_TO_WORLD")
-    print("const SPOT_TEXTURED_WEIGHT: &[([f32; 3], [f32; 3])] = &[")
+    out["spot_textured_weight"] = []
     for ang, phi in [(0, 0), (10, 0.3), (20, 2.0), (25, -1.0), (33, 4.0), (38, 1.0), (45, 0)]:
         a = math.radians(ang)
         local = np.array([math.sin(a) * math.cos(phi), math.sin(a) * math.sin(phi), math.cos(a)])
@@ -135,70 +129,72 @@ def main():
         it = mi.Interaction3f()
         it.p = mi.Point3f(ref)
         ds, wgt = spot_tex.sample_direction(it, mi.Point2f(0.5, 0.5))
-        print(f"    ({fmt(ref)}, {fmt(wgt)}),")
-    print("];")
+        out["spot_textured_weight"].append({"ref": vec(ref), "weight": vec(wgt)})
 
-    # ---- point, directional, constant ----
+    # ---- point, directional, constant (sample_direction from (0.3,-0.2,0.5)) ----
     it = mi.Interaction3f()
     it.p = mi.Point3f(0.3, -0.2, 0.5)
     point = mi.load_dict({"type": "point", "position": [1, 2, 3], "intensity": mi.ScalarColor3f(5, 6, 7)})
     ds, wgt = point.sample_direction(it, mi.Point2f(0.5, 0.5))
-    print(f"// point at (1,2,3), intensity (5,6,7), from (0.3,-0.2,0.5): d, dist, weight")
-    print(f"const POINT: ([f32; 3], f32, [f32; 3]) = ({fmt(ds.d)}, {ds.dist:.9e}, {fmt(wgt)});")
+    out["point"] = {"d": vec(ds.d), "dist": num(ds.dist), "weight": vec(wgt)}
     dl = mi.load_dict({"type": "directional", "direction": [1, -2, 0.5], "irradiance": mi.ScalarColor3f(3, 2, 1)})
     ds, wgt = dl.sample_direction(it, mi.Point2f(0.5, 0.5))
-    print(f"// directional towards (1,-2,0.5), irradiance (3,2,1): d, weight")
-    print(f"const DIRECTIONAL: ([f32; 3], [f32; 3]) = ({fmt(ds.d)}, {fmt(wgt)});")
+    out["directional"] = {"d": vec(ds.d), "weight": vec(wgt)}
     const = mi.load_dict({"type": "constant", "radiance": mi.ScalarColor3f(0.5, 1, 2)})
     ds, wgt = const.sample_direction(it, mi.Point2f(0.3, 0.7))
-    print(f"// constant radiance (0.5,1,2), sample (0.3,0.7): d, pdf, weight")
-    print(f"const CONSTANT: ([f32; 3], f32, [f32; 3]) = ({fmt(ds.d)}, {ds.pdf:.9e}, {fmt(wgt)});")
+    out["constant"] = {"d": vec(ds.d), "pdf": num(ds.pdf), "weight": vec(wgt)}
+    return out
 
-    # ---- textures ----
+
+def texture_values(mi):
+    out = {}
     uvs = [[0.1, 0.1], [0.6, 0.3], [-0.3, 1.2], [0.125, 1 / 6], [0.99, 0.51], [1.7, -0.45], [0.5, 0.5]]
-    print("const UVS: &[[f32; 2]] = &[" + ", ".join(fmt(uv) for uv in uvs) + "];")
+    out["uvs"] = [vec(uv) for uv in uvs]
     si = mi.SurfaceInteraction3f()
+
+    def values(t, at):
+        vals = []
+        for uv in at:
+            si.uv = mi.Point2f(uv)
+            vals.append(vec(t.eval(si)))
+        return vals
+
     cb_uv = mi.ScalarTransform4f().scale([3, 2, 1]).translate([0.1, 0.2, 0])
     cbs = [("default", mi.load_dict({"type": "checkerboard"})),
            ("custom", mi.load_dict({"type": "checkerboard", "color0": mi.ScalarColor3f(0.9, 0.5, 0.1),
                                    "color1": mi.ScalarColor3f(0.05, 0.1, 0.7), "to_uv": cb_uv}))]
-    print("const CHECKER_TO_UV: [[f64; 4]; 4] =", mat_rows(cb_uv) + ";")
+    out["checker_to_uv"] = mat_rows(cb_uv)
     cb_uvs = uvs + [[0.25, 0.75], [0.75, 0.75], [0.5, 0.25], [0.0, 0.0], [0.5, 0.5], [0.50001, 0.49999]]
-    print("const CHECKER_UVS: &[[f32; 2]] = &[" + ", ".join(fmt(uv) for uv in cb_uvs) + "];")
+    out["checker_uvs"] = [vec(uv) for uv in cb_uvs]
     for name, t in cbs:
-        vals = []
-        for uv in cb_uvs:
-            si.uv = mi.Point2f(uv)
-            vals.append(fmt(t.eval(si)))
-        print(f"// checkerboard {name}")
-        print(f"const CHECKER_{name.upper()}: &[[f32; 3]] = &[" + ", ".join(vals) + "];")
+        out[f"checker_{name}"] = values(t, cb_uvs)
     png = os.path.join(DATA, "tex_rgb8.png")
     tex_uv = mi.ScalarTransform4f().scale([2, 0.5, 1]).translate([0.3, 0, 0])
-    print("const BITMAP_UV_MATRIX: [[f64; 4]; 4] =", mat_rows(tex_uv) + ";")
+    out["bitmap_uv_matrix"] = mat_rows(tex_uv)
     cases = []
     for ft in ["bilinear", "nearest"]:
         for wm in ["repeat", "mirror", "clamp"]:
             cases.append((f"{ft}_{wm}", {"filter_type": ft, "wrap_mode": wm}))
     cases.append(("raw", {"raw": True}))
     cases.append(("to_uv", {"to_uv": tex_uv}))
+    # bitmap tex_rgb8.png with the parameters in the key (to_uv = bitmap_uv_matrix); "mean" is t.mean().
     for name, extra in cases:
         t = mi.load_dict({"type": "bitmap", "filename": png, **extra})
-        vals = []
-        for uv in uvs:
-            si.uv = mi.Point2f(uv)
-            vals.append(fmt(t.eval(si)))
-        desc = {k: ("BITMAP_UV_MATRIX" if k == "to_uv" else v) for k, v in extra.items()}
-        print(f"// bitmap tex_rgb8.png {desc}: mean = {t.mean():.9e}")
-        print(f"const BITMAP_{name.upper()}: &[[f32; 3]] = &[" + ", ".join(vals) + "];")
+        out[f"bitmap_{name}"] = {"mean": num(t.mean()), "values": values(t, uvs)}
     for fname in ["tex_y_float.exr", "tex_rgba_float.exr"]:
         t = mi.load_dict({"type": "bitmap", "filename": os.path.join(DATA, fname)})
-        vals = []
-        for uv in uvs:
-            si.uv = mi.Point2f(uv)
-            vals.append(fmt(t.eval(si)))
-        name = fname.split(".")[0].upper()
-        print(f"// bitmap {fname}: mean = {t.mean():.9e}")
-        print(f"const BITMAP_{name}: &[[f32; 3]] = &[" + ", ".join(vals) + "];")
+        out["bitmap_" + fname.split(".")[0]] = {"mean": num(t.mean()), "values": values(t, uvs)}
+    return out
+
+
+def main():
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
+    mi, _ = common.setup_mitsuba("scalar_rgb")
+    make_images(mi)
+    print(f"wrote images to {DATA}")
+    for name, values in [("emitters.json", emitter_values(mi)), ("textures.json", texture_values(mi))]:
+        values = {"mitsuba_version": mi.__version__, "variant": "scalar_rgb", **values}
+        print(f"wrote {common.write_test_json(name, values, indent=1)}")
 
 
 if __name__ == "__main__":

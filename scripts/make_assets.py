@@ -261,8 +261,7 @@ def write_serialized(path, meshes):
 # ----------------------------------------------------------------------------- main
 
 def verify_with_mitsuba(out, expected):
-    import mitsuba as mi
-    mi.set_variant("scalar_rgb")
+    mi, _ = common.setup_mitsuba("scalar_rgb")
     for fname, plugin, extra, nv, nf in expected:
         d = {"type": plugin, "filename": os.path.join(out, "meshes", fname), **extra}
         shape = mi.load_dict(d)
@@ -285,8 +284,7 @@ def main():
     os.makedirs(os.path.join(out, "textures"), exist_ok=True)
     os.makedirs(os.path.join(out, "meshes"), exist_ok=True)
 
-    import mitsuba as mi
-    mi.set_variant("scalar_rgb")
+    mi, _ = common.setup_mitsuba("scalar_rgb")
 
     sky = make_sky()
     sky_path = os.path.join(out, "textures", "sky.exr")

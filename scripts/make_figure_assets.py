@@ -302,8 +302,7 @@ def main():
           f"volume {signed_volume(verts, faces):.4f} m^3, bbox {np.round(lo, 3)} .. {np.round(hi, 3)}, "
           f"{os.path.getsize(ply) / 1e6:.2f} MB")
 
-    import mitsuba as mi
-    mi.set_variant("scalar_rgb")
+    mi, _ = common.setup_mitsuba("scalar_rgb")
     sky = make_sun_sky()
     exr = os.path.join(out, "sun_sky.exr")
     mi.Bitmap(sky, pixel_format=mi.Bitmap.PixelFormat.RGB).write(exr)

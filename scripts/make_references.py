@@ -56,15 +56,12 @@ import argparse
 import glob
 import json
 import os
-import struct
 import sys
-import time
 
 import numpy as np
 
-ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-LLVM_CANDIDATES = ["/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so",
-                   "/usr/lib/x86_64-linux-gnu/libLLVM-15.so", "/usr/lib/x86_64-linux-gnu/libLLVM-14.so"]
+import common
+from common import ROOT, develop, mean_and_variance, render_sums
 
 # Reference sample counts, chosen so that each scene takes about a minute or less with llvm_ad_rgb
 # on 2 cores (see the `seconds` recorded in reference/NAME.json).
@@ -89,7 +86,6 @@ DEFAULT_SPP = {
     "surfaces_anisotropic": 8192,
 }
 FALLBACK_SPP = 4096
-MAX_SAMPLES_PER_PASS = 1 << 22
 BLOCK = 8  # block size of the block-averaged z statistics printed by --check
 
 SRGB_TO_XYZ_Y = np.array([0.212671, 0.715160, 0.072169])  # row Y of Mitsuba's srgb_to_xyz
@@ -100,92 +96,14 @@ mi = None
 
 
 def setup_mitsuba(variant):
-    """Import mitsuba and set `variant`; llvm variants fall back to scalar_rgb when LLVM is missing."""
+    """Import mitsuba, set `variant` (scalar_rgb when LLVM is missing), register `rgb_moment`."""
     global mi
-    if "llvm" in variant and "DRJIT_LIBLLVM_PATH" not in os.environ:
-        for cand in LLVM_CANDIDATES:
-            if os.path.exists(cand):
-                os.environ["DRJIT_LIBLLVM_PATH"] = cand
-                break
-    import mitsuba
-    mi = mitsuba
-    try:
-        mi.set_variant(variant)
-    except Exception as err:  # noqa: BLE001 - any failure to set up the JIT backend
-        if variant == "scalar_rgb":
-            raise
-        print(f"warning: variant {variant} unavailable ({err}); falling back to scalar_rgb",
-              file=sys.stderr)
-        variant = "scalar_rgb"
-        mi.set_variant(variant)
-    register_rgb_moment()
+    mi, variant = common.setup_mitsuba(variant)
+    common.register_rgb_moment(mi)
     return variant
 
 
-def register_rgb_moment():
-    class RGBMomentIntegrator(mi.SamplingIntegrator):
-        """Mitsuba's `moment` integrator in RGB: AOVs mean.R/G/B, m2.R/G/B (+ m2.RG/GB/RB)."""
-
-        def __init__(self, props):
-            super().__init__(props)
-            self.nested = props["nested"]
-            self.cross = props.get("cross", False)
-
-        def sample(self, scene, sampler, ray, medium=None, active=True):
-            spec, valid, _ = self.nested.sample(scene, sampler, ray, medium, active)
-            c = mi.Color3f(spec)
-            aovs = [c.x, c.y, c.z, c.x * c.x, c.y * c.y, c.z * c.z]
-            if self.cross:
-                aovs += [c.x * c.y, c.y * c.z, c.x * c.z]
-            return spec, valid, aovs
-
-        def aov_names(self):
-            names = ["mean.R", "mean.G", "mean.B", "m2.R", "m2.G", "m2.B"]
-            return names + (["m2.RG", "m2.GB", "m2.RB"] if self.cross else [])
-
-        def to_string(self):
-            return f"RGBMomentIntegrator[nested={self.nested}]"
-
-    mi.register_integrator("rgb_moment", lambda props: RGBMomentIntegrator(props))
-
-
 # ----------------------------------------------------------------------------- rendering
-
-def raw_channels(film):
-    """The film's raw (unnormalised) storage as {channel name: (H, W) float64 array}."""
-    bmp = film.bitmap(raw=True)
-    arr = np.array(bmp, copy=True).astype(np.float64)
-    names = [bmp.struct_()[i].name for i in range(bmp.channel_count())]
-    return {n: arr[..., i] for i, n in enumerate(names)}
-
-
-def render_sums(scene, integrator, spp, seed):
-    """Render `spp` samples per pixel in passes; return summed raw channels and seconds."""
-    sensor = scene.sensors()[0]
-    w, h = sensor.film().crop_size()
-    pass_spp = max(1, min(spp, MAX_SAMPLES_PER_PASS // (w * h)))
-    sums, done, k = None, 0, 0
-    t0, c0 = time.time(), time.process_time()
-    while done < spp:
-        n = min(pass_spp, spp - done)
-        integrator.render(scene, sensor, seed=seed * 10007 + k, spp=n, develop=False)
-        ch = raw_channels(sensor.film())
-        sums = ch if sums is None else {c: sums[c] + ch[c] for c in sums}
-        done += n
-        k += 1
-    return sums, (time.time() - t0, time.process_time() - c0), k
-
-
-def develop(sums, names):
-    wsum = np.maximum(sums["W"], 1e-30)
-    return np.stack([sums[n] / wsum for n in names], axis=-1)
-
-
-def mean_and_variance(sums):
-    mean = develop(sums, ["mean.R", "mean.G", "mean.B"])
-    m2 = develop(sums, ["m2.R", "m2.G", "m2.B"])
-    return mean, np.maximum(m2 - mean * mean, 0.0)
-
 
 def load_scene(path):
     return mi.load_file(path)
@@ -201,42 +119,8 @@ def render_reference(path, spp, seed):
 
 # ----------------------------------------------------------------------------- filter factor
 
-def filter_1d(scene):
-    rf = scene.sensors()[0].film().rfilter()
-    radius = rf.radius()
-
-    def w(x):
-        flat = np.asarray(x, dtype=np.float64).ravel()
-        if mi.variant().startswith("scalar"):
-            vals = np.array([rf.eval(float(v)) for v in flat])
-        else:
-            vals = np.array(rf.eval(mi.Float(flat)))
-        return vals.reshape(np.shape(x))
-
-    return rf, radius, w
-
-
-def pixel_variance_factor(scene, samples_per_px=64):
-    """Per-pixel (H, W) map of sum(w^2) / (sum w)^2 * spp for uniform sample density 1/px^2.
-
-    Samples are drawn only inside the image, so border pixels see part of their filter support.
-    """
-    rf, radius, w = filter_1d(scene)
-    width, height = scene.sensors()[0].film().crop_size()
-
-    def factor_1d(n):
-        xs = (np.arange(n * samples_per_px) + 0.5) / samples_per_px   # quadrature over [0, n)
-        centres = np.arange(n) + 0.5
-        wx = w(xs[None, :] - centres[:, None])
-        a = wx.sum(axis=1) / samples_per_px
-        b = (wx * wx).sum(axis=1) / samples_per_px
-        return b / (a * a)
-
-    return factor_1d(height)[:, None] * factor_1d(width)[None, :]
-
-
 def interior_variance_factor(scene, n=4096):
-    rf, radius, w = filter_1d(scene)
+    rf, radius, w = common.filter_1d(mi, scene)
     xs = (np.arange(n) + 0.5) / n * 2 * radius - radius
     wx = w(xs)
     a = wx.sum() * 2 * radius / n
@@ -253,34 +137,8 @@ def write_exr(path, mean, var):
     bmp.write(path)
 
 
-def exr_channels(path):
-    """Parse an OpenEXR header; return [(channel name, pixel type)] (0 uint, 1 half, 2 float)."""
-    with open(path, "rb") as fh:
-        data = fh.read(1 << 16)
-    if struct.unpack_from("<I", data, 0)[0] != 20000630:
-        raise ValueError(f"{path}: not an OpenEXR file")
-    pos = 8
-    while data[pos] != 0:
-        end = data.index(b"\0", pos)
-        name = data[pos:end].decode()
-        end2 = data.index(b"\0", end + 1)
-        size = struct.unpack_from("<i", data, end2 + 1)[0]
-        value = data[end2 + 5:end2 + 5 + size]
-        pos = end2 + 5 + size
-        if name == "channels":
-            chans, p = [], 0
-            while value[p] != 0:
-                e = value.index(b"\0", p)
-                cname = value[p:e].decode()
-                ptype = struct.unpack_from("<i", value, e + 1)[0]
-                chans.append((cname, ptype))
-                p = e + 1 + 16
-            return chans
-    raise ValueError(f"{path}: no channels attribute")
-
-
 def check_exr_layout(path):
-    chans = dict(exr_channels(path))
+    chans = dict(common.exr_channels(path))
     want = ["R", "G", "B", "var.R", "var.G", "var.B"]
     if sorted(chans) != sorted(want) or any(chans[c] != 2 for c in want):
         raise RuntimeError(f"{path}: unexpected channel layout {chans}")
@@ -324,7 +182,7 @@ def zscore_check(path, spp, ref_var=None):
     scene, a, var_a, _, _ = render_reference(path, spp, seed=1000)
     _, b, var_b, _, _ = render_reference(path, spp, seed=2000)
     var = ref_var if ref_var is not None else 0.5 * (var_a + var_b)
-    f = pixel_variance_factor(scene)[..., None]
+    f = common.pixel_variance_factor(mi, scene)[..., None]
     denom = np.sqrt(2.0 * var * f / spp)
     mask = np.broadcast_to(denom > 0, a.shape)
     z = (a - b)[mask] / denom[mask]

@@ -14,12 +14,13 @@ Usage: python3 scripts/make_surface_assets.py
 """
 import json
 import os
-import struct
 
 import numpy as np
 from PIL import Image
 
-ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import common
+
+ROOT = common.ROOT
 
 
 def planks():
@@ -62,8 +63,7 @@ def write_pfm(path, img, little_endian):
 
 
 def formats():
-    import mitsuba as mi
-    mi.set_variant("scalar_rgb")
+    mi, _ = common.setup_mitsuba("scalar_rgb")
     out_dir = os.path.join(ROOT, "tests", "data", "formats")
     os.makedirs(out_dir, exist_ok=True)
     p = pattern()

@@ -25,7 +25,9 @@ import sys
 import tempfile
 import time
 
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import common
+
+REPO = common.ROOT
 
 
 def chunk_boundaries(spp):

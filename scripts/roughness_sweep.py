@@ -16,11 +16,11 @@ import json
 import os
 import statistics
 import subprocess
-import sys
 import tempfile
 
-ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-SNEE = os.path.join(ROOT, "target", "release", "snee")
+import common
+
+SNEE = os.path.join(common.ROOT, "target", "release", "snee")
 
 
 def boundary(alpha):
@@ -53,11 +53,8 @@ def scene(integrator, alpha, spp, rate):
 
 
 def read_exr_pixel(path):
-    """First channel value of a 1x1 snee EXR (float, uncompressed or zip), without mitsuba."""
-    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    from reproduce_figures import read_exr  # the script's own EXR reader
-    ch = read_exr(path)
-    return float(ch["R"].reshape(-1)[0])
+    """Channel R of a 1x1 snee EXR (float, uncompressed or zip), without mitsuba."""
+    return float(common.read_exr(path)["R"].reshape(-1)[0])
 
 
 def main():

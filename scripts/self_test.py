@@ -7,8 +7,8 @@ light that reaches a medium only through a narrow glossy lobe) fail much more of
 means are skewed, so the t-test over batches is not calibrated at the test's sample count.
 
 For each scene and each trial this renders, with Mitsuba (llvm_ad_rgb, independent sampler, fresh
-seeds), BATCHES = 16 batches of SPP_PER_BATCH samples with the `rgb_moment` wrapper of
-make_references.py, and applies exactly the statistics of tests/references.rs against
+seeds), BATCHES = 16 batches of SPP_PER_BATCH samples with the `rgb_moment` wrapper (common.py,
+as make_references.py renders the references), and applies exactly the statistics of tests/references.rs against
 reference/NAME.exr:
   - per pixel: z = (mean - ref) / sqrt(var_ours + var_ref + (1e-4 ref)^2), var_ours from the
     second-moment channel times the filter's per-pixel variance factor over the total spp,
@@ -23,12 +23,11 @@ Usage:
 import argparse
 import json
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import make_references as mr  # noqa: E402
+import common
+from common import ROOT, sidak
 
 ALPHA = 0.01
 BATCHES = 16
@@ -36,17 +35,10 @@ BLOCK = 8
 PRECISION = 1e-4
 
 
-def sidak(alpha, n):
-    return 1.0 - (1.0 - alpha) ** (1.0 / max(n, 1))
-
-
-def read_reference(name):
-    bmp = mr.mi.Bitmap(os.path.join(mr.ROOT, "reference", name + ".exr"))
-    names = [bmp.struct_()[i].name for i in range(bmp.channel_count())]
-    arr = np.array(bmp).astype(np.float64)
-    mean = np.stack([arr[..., names.index(c)] for c in "RGB"], axis=-1)
-    var = np.stack([arr[..., names.index("var." + c)] for c in "RGB"], axis=-1)
-    with open(os.path.join(mr.ROOT, "reference", name + ".json")) as fh:
+def read_reference(mi, name):
+    ch = common.bitmap_channels(mi, os.path.join(ROOT, "reference", name + ".exr"))
+    mean, var = common.rgb(ch), common.rgb(ch, "var.")
+    with open(os.path.join(ROOT, "reference", name + ".json")) as fh:
         spp_ref = json.load(fh)["spp"]
     return mean, var, spp_ref
 
@@ -55,10 +47,10 @@ def trial(scene, integrator, spp, seed0, ref_mean, ref_var_pix, factor):
     from scipy.stats import norm, t as student_t
     batches, m2s = [], []
     for b in range(BATCHES):
-        sums, _, _ = mr.render_sums(scene, integrator, spp, seed0 + b)
-        mean, _ = mr.mean_and_variance(sums)
+        sums, _, _ = common.render_sums(scene, integrator, spp, seed0 + b)
+        mean, _ = common.mean_and_variance(sums)
         batches.append(mean)
-        m2s.append(mr.develop(sums, ["m2.R", "m2.G", "m2.B"]))
+        m2s.append(common.develop(sums, ["m2.R", "m2.G", "m2.B"]))
     batches = np.array(batches)
     mean = batches.mean(axis=0)
     m2 = np.mean(m2s, axis=0)
@@ -102,15 +94,16 @@ def main():
     ap.add_argument("--trials", type=int, default=5, help="independent repetitions (default 5)")
     ap.add_argument("--variant", default="llvm_ad_rgb")
     args = ap.parse_args()
-    variant = mr.setup_mitsuba(args.variant)
-    print(f"Mitsuba {mr.mi.__version__} {variant}: {BATCHES} batches x {args.spp_per_batch} spp "
+    mi, variant = common.setup_mitsuba(args.variant)
+    common.register_rgb_moment(mi)
+    print(f"Mitsuba {mi.__version__} {variant}: {BATCHES} batches x {args.spp_per_batch} spp "
           f"per trial, tests of tests/references.rs at family-wise {ALPHA}")
     for path in args.scenes:
         name = os.path.splitext(os.path.basename(path))[0]
-        ref_mean, ref_var, spp_ref = read_reference(name)
-        scene = mr.load_scene(path)
-        integrator = mr.mi.load_dict({"type": "rgb_moment", "nested": scene.integrator()})
-        factor = mr.pixel_variance_factor(scene)
+        ref_mean, ref_var, spp_ref = read_reference(mi, name)
+        scene = mi.load_file(path)
+        integrator = mi.load_dict({"type": "rgb_moment", "nested": scene.integrator()})
+        factor = common.pixel_variance_factor(mi, scene)
         ref_var_pix = ref_var * factor[..., None] / spp_ref
         fails_pix = fails_reg = 0
         for k in range(args.trials):

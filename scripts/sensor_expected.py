@@ -1,22 +1,23 @@
 #!/usr/bin/env python3
-"""Print reference values from Mitsuba 3 for tests/sensor.rs and tests/film.rs.
+"""Reference values from Mitsuba 3 for the sensor and film tests: writes tests/data/sensor.json.
 
 For several perspective-camera configurations this calls Mitsuba's
 `sensor.sample_ray(time, wavelength_sample, position_sample, aperture_sample)` and prints the
 ray origin, direction and length, together with the camera's `to_world` matrix as Mitsuba built it
-(so the Rust test does not depend on our own `look_at`). Mitsuba's `position_sample` is relative to
-the film's crop window; the printed `pos` is the same point in pixels of the full film
+(so the Rust test does not depend on our own `look_at`) ("cameras"). Mitsuba's `position_sample` is
+relative to the film's crop window; the stored `pos` is the same point in pixels of the full film
 (`crop_offset + position_sample * crop_size`), which is what `Camera::sample_ray` takes.
-It also prints `rfilter.eval(x)` for the gaussian, tent and box filters.
+It also stores `rfilter.eval(x)` for the gaussian, tent and box filters ("filters") and the weights
+and developed values of an ImageBlock splatted with a few samples, per filter ("image_block").
+Numbers keep 10 significant digits (8 for the image blocks).
 
 Usage: python3 scripts/sensor_expected.py            (needs `pip install mitsuba==3.9.1`)
-Output goes to stdout as Rust array literals to paste into the tests.
 """
 import argparse
-import os
 
-os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1")
-import mitsuba as mi  # noqa: E402
+import common
+
+mi = None  # the mitsuba module, set in main()
 
 CONFIGS = [
     # name, sensor parameters (besides film and to_world), film (w, h, crop), look_at (origin, target, up) or None
@@ -37,11 +38,17 @@ CONFIGS = [
 SAMPLES = [(0.5, 0.5), (0.0, 0.0), (1.0, 1.0), (0.25, 0.8), (0.9, 0.1)]
 
 
-def fmt(v):
-    return "[" + ", ".join(f"{float(x):.9e}" for x in v) + "]"
+def num(x, digits=10):
+    """A number rounded as the tests read it: `digits` significant digits."""
+    return common.rounded(x, digits)
+
+
+def vec(v):
+    return [num(x) for x in v]
 
 
 def cameras():
+    out = []
     for name, params, (w, h, crop), look in CONFIGS:
         film = {"type": "hdrfilm", "width": w, "height": h}
         if crop is not None:
@@ -54,31 +61,28 @@ def cameras():
         rows = [[float(m[r][c]) for c in range(4)] for r in range(4)]
         co = crop[:2] if crop else (0, 0)
         cs = crop[2:] if crop else (w, h)
-        print(f"// {name}: {params} film {w}x{h} crop {crop} look_at {look}")
-        print("Case {")
-        print(f"    name: {name!r},".replace("'", '"'))
-        ps = ", ".join(f'("{k}", F({float(v)!r}))' if not isinstance(v, str) else f'("{k}", S("{v}"))'
-                       for k, v in params.items())
-        print(f"    params: &[{ps}],")
-        print(f"    film: ({w}, {h}, {'Some(' + repr(tuple(crop)) + ')' if crop else 'None'}),")
-        print(f"    to_world_rows: [{', '.join(fmt(r) for r in rows)}],")
-        print("    rays: &[")
+        rays = []
         for s in SAMPLES:
             ray, _ = sensor.sample_ray(0.0, 0.5, mi.Point2f(*s), mi.Point2f(0.5, 0.5))
             pos = (co[0] + s[0] * cs[0], co[1] + s[1] * cs[1])
-            print(f"        ({fmt(pos)}, {fmt(ray.o)}, {fmt(ray.d)}, {float(ray.maxt):.9e}),")
-        print("    ],")
-        print("},")
+            rays.append({"pos": vec(pos), "o": vec(ray.o), "d": vec(ray.d), "maxt": num(ray.maxt)})
+        out.append({"name": name, "params": params, "film": {"width": w, "height": h, "crop": crop},
+                    "look_at": look, "to_world_rows": [vec(r) for r in rows], "rays": rays})
+    return out
+
+
+FILTERS = [{"type": "gaussian"}, {"type": "gaussian", "stddev": 0.3}, {"type": "gaussian", "stddev": 1.0},
+           {"type": "tent"}, {"type": "tent", "radius": 1.5}, {"type": "box"}]
 
 
 def filters():
     xs = [0.0, 0.1, 0.25, 0.49, 0.5, 0.75, 1.0, 1.2, 1.5, 1.9, 1.99, 2.0, 2.3, 2.5, 3.0, 3.5, -0.3, -1.1]
-    for name, d in [("gaussian", {"type": "gaussian"}), ("gaussian_0.3", {"type": "gaussian", "stddev": 0.3}),
-                    ("gaussian_1", {"type": "gaussian", "stddev": 1.0}), ("tent", {"type": "tent"}),
-                    ("tent_1.5", {"type": "tent", "radius": 1.5}), ("box", {"type": "box"})]:
+    out = []
+    for d in FILTERS:
         f = mi.load_dict(d)
-        print(f"// {name}: radius {f.radius()}, border {f.border_size()}")
-        print("&[" + ", ".join(f"({x:.3}, {float(f.eval(x)):.9e})" for x in xs) + "],")
+        out.append({"filter": d, "radius": float(f.radius()), "border": int(f.border_size()),
+                    "values": [[float(f"{x:.3}"), num(f.eval(x))] for x in xs]})
+    return out
 
 
 # ImageBlock test: interior offset/size, and samples (x, y, value); some fall outside the block.
@@ -88,12 +92,13 @@ BLOCK_SAMPLES = [(12.3, 22.7, 1.0), (13.9, 21.2, 2.0), (10.05, 20.5, 3.0), (15.9
 
 
 def image_blocks():
-    """Splat BLOCK_SAMPLES with Mitsuba's ImageBlock as the llvm variants render (eval, no table)."""
+    """Splat BLOCK_SAMPLES with Mitsuba's ImageBlock as the llvm variants render (eval, no table):
+    per filter the weights and the developed values of the interior pixels, row-major."""
     import numpy as np
-    mi.set_variant("llvm_ad_rgb")
+    common.setup_mitsuba("llvm_ad_rgb")
     xs, ys, vs = (mi.Float([s[i] for s in BLOCK_SAMPLES]) for i in range(3))
-    for name, d in [("gaussian", {"type": "gaussian"}), ("tent_1.5", {"type": "tent", "radius": 1.5}),
-                    ("gaussian_1", {"type": "gaussian", "stddev": 1.0}), ("box", {"type": "box"})]:
+    blocks = []
+    for d in [FILTERS[0], FILTERS[4], FILTERS[2], FILTERS[5]]:
         f = mi.load_dict(d)
         b = mi.ImageBlock(size=BLOCK_SIZE, offset=BLOCK_OFFSET, channel_count=2, rfilter=f, border=False,
                           normalize=False, coalesce=True)
@@ -101,19 +106,19 @@ def image_blocks():
         t = np.array(b.tensor())
         w = t[:, :, 1].ravel()
         v = np.where(w != 0, t[:, :, 0].ravel() / np.where(w != 0, w, 1), 0)
-        print(f"// ImageBlock {name}: weights, then developed values (row-major {BLOCK_SIZE[0]}x{BLOCK_SIZE[1]})")
-        print("(&[" + ", ".join(f"{x:.7e}" for x in w) + "],")
-        print(" &[" + ", ".join(f"{x:.7e}" for x in v) + "]),")
+        blocks.append({"filter": d, "weights": [num(x, 8) for x in w], "values": [num(x, 8) for x in v]})
+    return {"offset": BLOCK_OFFSET, "size": BLOCK_SIZE, "samples": BLOCK_SAMPLES, "blocks": blocks}
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (default scalar_rgb)")
     args = ap.parse_args()
-    mi.set_variant(args.variant)
-    cameras()
-    filters()
-    image_blocks()
+    global mi
+    mi, _ = common.setup_mitsuba(args.variant)
+    out = {"mitsuba_version": mi.__version__, "variant": args.variant, "cameras": cameras(), "filters": filters()}
+    out["image_block"] = {"variant": "llvm_ad_rgb", **image_blocks()}
+    print(f"wrote {common.write_test_json('sensor.json', out, indent=1)}")
 
 
 if __name__ == "__main__":

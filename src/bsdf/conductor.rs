@@ -56,13 +56,13 @@ impl ComplexIor {
             let k = unbounded_texture(props, "k", Spectrum::ONE, resolver)?;
             return Ok(ComplexIor { eta, k });
         }
-        match MATERIALS.iter().find(|(name, _, _)| *name == material) {
+        match MATERIALS.iter().find(|(names, _, _)| names.contains(&material.as_str())) {
             Some((_, eta, k)) => Ok(ComplexIor {
                 eta: Texture::Const(Spectrum::from_array(*eta)),
                 k: Texture::Const(Spectrum::from_array(*k)),
             }),
             None => {
-                let names: Vec<&str> = MATERIALS.iter().map(|(n, _, _)| *n).collect();
+                let names: Vec<&str> = MATERIALS.iter().flat_map(|(n, _, _)| n.iter().copied()).collect();
                 Err(props.error(
                     "material",
                     format!(

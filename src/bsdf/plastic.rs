@@ -78,6 +78,15 @@ pub(super) fn read_coating_eta(props: &Props) -> Result<f32> {
 
 /// Mitsuba's specular sampling weight: mean(specular) / (mean(diffuse) + mean(specular)), with
 /// a texture's mean read as the luminance of its mean colour (Mitsuba's `Texture::mean`).
+/// The lobes `ctx` enables (specular: component 0 with `specular_flag`, diffuse: component 1) for
+/// light arriving from `cos_theta_i`; `None` where Mitsuba's plastics give nothing: from below the
+/// surface, or with neither lobe enabled.
+pub(super) fn front_lobes(ctx: &BsdfContext, specular_flag: u32, cos_theta_i: f32) -> Option<(bool, bool)> {
+    let has_specular = ctx.is_enabled(specular_flag, 0);
+    let has_diffuse = ctx.is_enabled(flags::DIFFUSE_REFLECTION, 1);
+    (!(cos_theta_i <= 0.0) && (has_specular || has_diffuse)).then_some((has_specular, has_diffuse))
+}
+
 pub(super) fn specular_sampling_weight(diffuse: &Texture, specular: &Option<Texture>) -> f32 {
     let d_mean = texture_mean(diffuse);
     let s_mean = specular.as_ref().map_or(1.0, texture_mean);
@@ -141,12 +150,8 @@ impl Plastic {
         sample1: f32,
         sample2: Vec2,
     ) -> Option<(BsdfSample, Spectrum)> {
-        let has_specular = ctx.is_enabled(flags::DELTA_REFLECTION, 0);
-        let has_diffuse = ctx.is_enabled(flags::DIFFUSE_REFLECTION, 1);
         let cos_theta_i = si.wi.z;
-        if cos_theta_i <= 0.0 || !(has_specular || has_diffuse) {
-            return None;
-        }
+        let (has_specular, has_diffuse) = front_lobes(ctx, flags::DELTA_REFLECTION, cos_theta_i)?;
         let f_i = fresnel(cos_theta_i, self.eta).0;
         let prob_specular = self.prob_specular(f_i, has_specular, has_diffuse);
         if sample1 < prob_specular {

@@ -38,7 +38,7 @@
 
 use super::fresnel::{fresnel, refract_m};
 use super::microfacet::{read_distribution, MicrofacetDistribution, MicrofacetType};
-use super::plastic::{read_coating_eta, specular_sampling_weight};
+use super::plastic::{front_lobes, read_coating_eta, specular_sampling_weight};
 use super::{flags, optional_texture, times_texture, BsdfContext, BsdfSample};
 use crate::color::Spectrum;
 use crate::interaction::SurfaceInteraction;
@@ -145,12 +145,8 @@ impl RoughPlastic {
         sample1: f32,
         sample2: Vec2,
     ) -> Option<(BsdfSample, Spectrum)> {
-        let has_specular = ctx.is_enabled(flags::GLOSSY_REFLECTION, 0);
-        let has_diffuse = ctx.is_enabled(flags::DIFFUSE_REFLECTION, 1);
         let cos_theta_i = si.wi.z;
-        if cos_theta_i <= 0.0 || !(has_specular || has_diffuse) {
-            return None;
-        }
+        let (has_specular, has_diffuse) = front_lobes(ctx, flags::GLOSSY_REFLECTION, cos_theta_i)?;
         let t_i = self.transmittance(cos_theta_i);
         let prob_specular = self.prob_specular(t_i, has_specular, has_diffuse);
         let (wo, sampled_type, sampled_component) = if sample1 < prob_specular {

@@ -20,8 +20,9 @@
 //! </bsdf>
 //! ```
 
+use super::dielectric::Dielectric;
 use super::fresnel::{fresnel, reflect_local};
-use super::{flags, optional_texture, read_iors, times_texture, BsdfContext, BsdfSample};
+use super::{flags, times_texture, BsdfContext, BsdfSample};
 use crate::color::Spectrum;
 use crate::interaction::SurfaceInteraction;
 use crate::math::Vec2;
@@ -48,13 +49,10 @@ pub(super) fn component_flags(i: u32) -> u32 {
 }
 
 impl ThinDielectric {
+    /// The parameters are `dielectric`'s.
     pub fn from_props(props: &Props, resolver: &FileResolver) -> Result<ThinDielectric> {
-        let (int_ior, ext_ior) = read_iors(props)?;
-        Ok(ThinDielectric {
-            eta: int_ior / ext_ior,
-            specular_reflectance: optional_texture(props, "specular_reflectance", resolver)?,
-            specular_transmittance: optional_texture(props, "specular_transmittance", resolver)?,
-        })
+        let Dielectric { eta, specular_reflectance, specular_transmittance } = Dielectric::from_props(props, resolver)?;
+        Ok(ThinDielectric { eta, specular_reflectance, specular_transmittance })
     }
 
     /// Reflectance of the sheet R' = R + T²R/(1 − R²) = 2R/(1 + R), including internal reflections.

@@ -17,7 +17,7 @@
 //! </emitter>
 //! ```
 
-use super::{check_transform, exclusive_with_to_world, BoundingSphere};
+use super::{shortcut_or_to_world, BoundingSphere};
 use crate::color::Spectrum;
 use crate::interaction::DirectionSample;
 use crate::math::{Vec2, Vec3};
@@ -34,15 +34,7 @@ pub struct DirectionalEmitter {
 
 impl DirectionalEmitter {
     pub fn from_props(props: &Props) -> Result<DirectionalEmitter> {
-        exclusive_with_to_world(props, "direction")?;
-        let d = match props.vector_opt("direction")? {
-            Some(v) => v,
-            None => {
-                let m = props.transform("to_world")?;
-                check_transform(props, "to_world", &m)?;
-                m.transform_vector3(Vec3::Z)
-            }
-        };
+        let d = shortcut_or_to_world(props, "direction", Props::vector_opt, |m| m.transform_vector3(Vec3::Z))?;
         let name = if props.has("direction") { "direction" } else { "to_world" };
         if !(d.is_finite() && d.length_squared() > 0.0) {
             return Err(props.error(name, "the light direction must be a finite non-zero vector"));

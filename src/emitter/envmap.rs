@@ -34,11 +34,11 @@ use super::distribution::Distribution2D;
 use super::{check_transform, BoundingSphere};
 use crate::color::{luminance, Spectrum};
 use crate::interaction::DirectionSample;
-use crate::io::read::read_image;
 use crate::math::{safe_sqrt, Mat4, Vec2, Vec3, INV_PI, INV_TWO_PI, PI};
 use crate::scene::desc::Props;
 use crate::scene::resolver::FileResolver;
 use crate::scene::{Error, Result};
+use crate::texture::bitmap::{read_filename_image, required_filename};
 use std::sync::Arc;
 
 #[derive(Clone)]
@@ -60,36 +60,16 @@ pub struct EnvironmentEmitter {
     pub bsphere: BoundingSphere,
 }
 
-impl std::fmt::Debug for EnvironmentEmitter {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("EnvironmentEmitter")
-            .field("filename", &self.filename)
-            .field("width", &self.width)
-            .field("height", &self.height)
-            .field("scale", &self.scale)
-            .field("to_world", &self.to_world)
-            .field("bsphere", &self.bsphere)
-            .finish_non_exhaustive()
-    }
-}
-
 impl EnvironmentEmitter {
     pub fn from_props(props: &Props, resolver: &FileResolver) -> Result<EnvironmentEmitter> {
-        let filename = props
-            .string_opt("filename")?
-            .ok_or_else(|| props.error("filename", "envmap requires the string property \"filename\""))?;
-        let pos = props.pos_of("filename");
-        let path = resolver.resolve_at(&filename, &pos)?;
-        crate::scene::limits::check_image(&path, "filename", &pos)?;
-        let bitmap = read_image(&path, true).map_err(|e| Error::at(&pos, e.to_string()))?;
-        let file = path.display().to_string();
-        let pixels = bitmap.to_rgb_pixels(&file).map_err(|e| Error::at(&pos, e.to_string()))?;
+        let filename = required_filename(props, "envmap")?;
+        let image = read_filename_image(props, &filename, resolver, true)?;
 
         let scale = props.float("scale", 1.0)?;
         if !(scale.is_finite() && scale >= 0.0) {
             return Err(props.error("scale", "envmap: \"scale\" must be finite and non-negative"));
         }
-        let brightest = pixels.iter().fold(0.0f32, |m, p| m.max(p.abs().max_element()));
+        let brightest = image.pixels.iter().fold(0.0f32, |m, p| m.max(p.abs().max_element()));
         if !(scale * brightest <= crate::scene::desc::MAX_EMISSION) {
             let msg = format!(
                 "envmap: scale ({scale:e}) × the brightest pixel ({brightest}) is beyond {:e}",
@@ -106,8 +86,8 @@ impl EnvironmentEmitter {
             ));
         }
         let mis_compensation = props.bool("mis_compensation", false)?;
-        Self::new(filename, &file, bitmap.width, bitmap.height, &pixels, scale, to_world, mis_compensation)
-            .map_err(|e| Error::at(&pos, e.msg))
+        Self::new(filename, &image.file, image.width, image.height, &image.pixels, scale, to_world, mis_compensation)
+            .map_err(|e| Error::at(&image.pos, e.msg))
     }
 
     /// Build from `width × height` linear RGB pixels (row 0 = +Y pole). `file` names the source
@@ -295,6 +275,19 @@ impl EnvironmentEmitter {
         } else {
             0.0
         }
+    }
+}
+
+impl std::fmt::Debug for EnvironmentEmitter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EnvironmentEmitter")
+            .field("filename", &self.filename)
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .field("scale", &self.scale)
+            .field("to_world", &self.to_world)
+            .field("bsphere", &self.bsphere)
+            .finish_non_exhaustive()
     }
 }
 

@@ -154,16 +154,29 @@ impl BoundingSphere {
     }
 }
 
-/// A transform given either as `to_world` or by a shortcut parameter (`position`, `direction`),
-/// never both (Mitsuba's rule). Returns the error at the shortcut's position.
-pub(crate) fn exclusive_with_to_world(props: &crate::scene::desc::Props, shortcut: &str) -> Result<()> {
+/// A position or direction given either by a shortcut parameter (`position`, `direction`; read
+/// with `read`) or by `to_world` (mapped with `from_to_world`), never both (Mitsuba's rule; the
+/// error is at the shortcut's position).
+pub(crate) fn shortcut_or_to_world(
+    props: &crate::scene::desc::Props,
+    shortcut: &str,
+    read: fn(&crate::scene::desc::Props, &str) -> Result<Option<glam::Vec3>>,
+    from_to_world: fn(&glam::Mat4) -> glam::Vec3,
+) -> Result<glam::Vec3> {
     if props.has(shortcut) && props.has("to_world") {
         return Err(props.error(
             shortcut,
             format!("only one of the parameters \"{shortcut}\" and \"to_world\" can be specified at the same time"),
         ));
     }
-    Ok(())
+    match read(props, shortcut)? {
+        Some(v) => Ok(v),
+        None => {
+            let m = props.transform("to_world")?;
+            check_transform(props, "to_world", &m)?;
+            Ok(from_to_world(&m))
+        }
+    }
 }
 
 /// Check that a transform is usable (finite and invertible); `name` is the property.

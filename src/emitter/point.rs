@@ -16,7 +16,7 @@
 //! </emitter>
 //! ```
 
-use super::{check_transform, exclusive_with_to_world};
+use super::shortcut_or_to_world;
 use crate::color::Spectrum;
 use crate::interaction::DirectionSample;
 use crate::math::{Vec2, Vec3};
@@ -32,15 +32,7 @@ pub struct PointEmitter {
 
 impl PointEmitter {
     pub fn from_props(props: &Props) -> Result<PointEmitter> {
-        exclusive_with_to_world(props, "position")?;
-        let p = match props.point_opt("position")? {
-            Some(p) => p,
-            None => {
-                let m = props.transform("to_world")?;
-                check_transform(props, "to_world", &m)?;
-                m.transform_point3(Vec3::ZERO)
-            }
-        };
+        let p = shortcut_or_to_world(props, "position", Props::point_opt, |m| m.transform_point3(Vec3::ZERO))?;
         if !p.is_finite() {
             return Err(props.error("position", "the light position is not finite"));
         }

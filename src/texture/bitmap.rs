@@ -30,7 +30,7 @@ use crate::io::read::read_image;
 use crate::math::Vec2;
 use crate::scene::desc::Props;
 use crate::scene::resolver::FileResolver;
-use crate::scene::{Error, Result};
+use crate::scene::{Error, Result, SrcPos};
 use glam::Affine2;
 
 /// How pixel values are interpolated.
@@ -69,6 +69,43 @@ impl WrapMode {
     }
 }
 
+/// The string property `filename` that `plugin` (`bitmap`, `envmap`) requires.
+pub(crate) fn required_filename(props: &Props, plugin: &str) -> Result<String> {
+    props
+        .string_opt("filename")?
+        .ok_or_else(|| props.error("filename", format!("{plugin} requires the string property \"filename\"")))
+}
+
+/// An image file named by a `filename` property, read as linear RGB.
+pub(crate) struct FilenameImage {
+    /// The resolved path as text, for error messages.
+    pub file: String,
+    /// Where the scene gives `filename`.
+    pub pos: SrcPos,
+    pub width: usize,
+    pub height: usize,
+    /// Row by row, row 0 at the top.
+    pub pixels: Vec<Spectrum>,
+}
+
+/// Resolve `filename` (the value of the `filename` property) against the scene's folders, refuse
+/// it beyond the size limits, and read it (sRGB → linear for 8/16-bit data when `to_linear`), with
+/// errors at the property's position. Shared by the `bitmap` texture and the `envmap` emitter.
+pub(crate) fn read_filename_image(
+    props: &Props,
+    filename: &str,
+    resolver: &FileResolver,
+    to_linear: bool,
+) -> Result<FilenameImage> {
+    let pos = props.pos_of("filename");
+    let path = resolver.resolve_at(filename, &pos)?;
+    crate::scene::limits::check_image(&path, "filename", &pos)?;
+    let bitmap = read_image(&path, to_linear).map_err(|e| Error::at(&pos, e.to_string()))?;
+    let file = path.display().to_string();
+    let pixels = bitmap.to_rgb_pixels(&file).map_err(|e| Error::at(&pos, e.to_string()))?;
+    Ok(FilenameImage { file, pos, width: bitmap.width, height: bitmap.height, pixels })
+}
+
 #[derive(Clone)]
 pub struct BitmapTexture {
     pub filename: String,
@@ -98,9 +135,7 @@ impl std::fmt::Debug for BitmapTexture {
 
 impl BitmapTexture {
     pub fn from_props(props: &Props, resolver: &FileResolver) -> Result<BitmapTexture> {
-        let filename = props
-            .string_opt("filename")?
-            .ok_or_else(|| props.error("filename", "bitmap requires the string property \"filename\""))?;
+        let filename = required_filename(props, "bitmap")?;
         let filter = match props.string("filter_type", "bilinear")?.as_str() {
             "bilinear" => FilterType::Bilinear,
             "nearest" => FilterType::Nearest,
@@ -131,14 +166,9 @@ impl BitmapTexture {
         }
         props.bool("accel", true)?;
 
-        let pos = props.pos_of("filename");
-        let path = resolver.resolve_at(&filename, &pos)?;
-        crate::scene::limits::check_image(&path, "filename", &pos)?;
-        let bitmap = read_image(&path, !raw).map_err(|e| Error::at(&pos, e.to_string()))?;
-        let file = path.display().to_string();
-        let pixels = bitmap.to_rgb_pixels(&file).map_err(|e| Error::at(&pos, e.to_string()))?;
-        Self::new(filename, &file, bitmap.width, bitmap.height, pixels, filter, wrap, to_uv)
-            .map_err(|e| Error::at(&pos, e.msg))
+        let image = read_filename_image(props, &filename, resolver, !raw)?;
+        Self::new(filename, &image.file, image.width, image.height, image.pixels, filter, wrap, to_uv)
+            .map_err(|e| Error::at(&image.pos, e.msg))
     }
 
     /// Build from `width × height` linear colours (row 0 = top); `file` names the source in errors.

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Write the PLY/OBJ files of this folder that tests/meshes.rs compares against Mitsuba 3.9.
+"""Write the PLY/OBJ files of this folder that tests/meshes/formats.rs compares against Mitsuba 3.9.
 
     python3 make_ply_obj.py            # (re)writes the files
     python3 make_ply_obj.py --check    # also prints what Mitsuba loads from them

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Write the small Mitsuba `.serialized` test files in this folder (an independent writer for
-tests/meshes.rs), following the format of Mitsuba 3.9 `src/shapes/serialized.cpp`.
+tests/meshes/formats.rs), following the format of Mitsuba 3.9 `src/shapes/serialized.cpp`.
 
     python3 make_serialized.py            # writes two_meshes_v4.serialized, two_meshes_v3.serialized
     python3 make_serialized.py --check    # also loads them with Mitsuba and prints what it read

@@ -1,14 +1,8 @@
 //! The `snee` command line: summaries, errors with `file:line:col`, render options, statistics
 //! and determinism across thread counts.
 
+use crate::snee;
 use std::path::PathBuf;
-use std::process::Command;
-
-fn snee() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_snee"));
-    c.current_dir(env!("CARGO_MANIFEST_DIR"));
-    c
-}
 
 fn out_dir() -> PathBuf {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/test-output/cli");

@@ -1,7 +1,8 @@
 //! Textures against Mitsuba 3.9, and the image reader (EXR: half/float, PIZ/ZIP/RLE/none, RGB(A)/Y;
 //! PNG: 8/16 bit, grey/RGB(A); bad files).
 //!
-//! Reference numbers from `scripts/emitter_expected.py` (which writes the images in `tests/data/`):
+//! Reference numbers in `tests/data/textures.json`, written by `scripts/emitter_expected.py` (which
+//! writes the images in `tests/data/` too):
 //!
 //! ```python
 //! t = mi.load_dict({"type": "bitmap", "filename": "tests/data/tex_rgb8.png", "filter_type": ft, "wrap_mode": wm})
@@ -9,9 +10,8 @@
 //! ```
 //! Mitsuba stores 8-bit textures in half precision, hence a relative tolerance of 1e-3 for PNG data.
 
-// The reference numbers are pasted as Mitsuba printed them (9 significant digits).
-#![allow(clippy::excessive_precision)]
-
+use crate::{data_dir, mitsuba_json, num, rows4, transform, vec2, vec3};
+use serde_json::Value as Json;
 use snee::color::{luminance, Spectrum};
 use snee::io::read::{read_image, srgb_to_linear_value, Bitmap};
 use snee::math::Vec2;
@@ -22,10 +22,6 @@ use snee::texture::Texture;
 use std::path::{Path, PathBuf};
 
 // ---- Helpers ----
-
-fn data_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data")
-}
 
 fn resolver() -> FileResolver {
     FileResolver { paths: vec![data_dir(), scratch_dir()] }
@@ -59,206 +55,39 @@ fn s(v: &str) -> Value {
     Value::String(v.into())
 }
 
-fn transform(rows: [[f64; 4]; 4]) -> Value {
-    Value::Transform(glam::DMat4::from_cols_array_2d(&rows).transpose())
-}
-
+/// `t` at each of `uvs` against Mitsuba's values `want` (JSON arrays of 2- and 3-vectors).
 #[track_caller]
-fn check_values(t: &Texture, uvs: &[[f32; 2]], want: &[[f32; 3]], rel: f32, what: &str) {
+fn check_values(t: &Texture, uvs: &Json, want: &Json, rel: f32, what: &str) {
+    let (uvs, want) = (uvs.as_array().unwrap(), want.as_array().unwrap());
     assert_eq!(uvs.len(), want.len());
     for (uv, w) in uvs.iter().zip(want) {
-        let got = t.eval(Vec2::from_array(*uv));
-        let w = Spectrum::from_array(*w);
+        let (uv, w) = (vec2(uv), vec3(w));
+        let got = t.eval(uv);
         let err = (got - w).abs().max_element();
         assert!(err <= rel * w.abs().max_element().max(1e-3), "{what} at uv {uv:?}: got {got}, Mitsuba {w}");
     }
 }
 
-// ---- Values from Mitsuba (scripts/emitter_expected.py) ----
-
-const UVS: &[[f32; 2]] = &[
-    [1.000000000e-01, 1.000000000e-01],
-    [6.000000000e-01, 3.000000000e-01],
-    [-3.000000000e-01, 1.200000000e+00],
-    [1.250000000e-01, 1.666666667e-01],
-    [9.900000000e-01, 5.100000000e-01],
-    [1.700000000e+00, -4.500000000e-01],
-    [5.000000000e-01, 5.000000000e-01],
-];
-const CHECKER_TO_UV: [[f64; 4]; 4] = [
-    [3.000000000e+00, 0.000000000e+00, 0.000000000e+00, 3.000000119e-01],
-    [0.000000000e+00, 2.000000000e+00, 0.000000000e+00, 4.000000060e-01],
-    [0.000000000e+00, 0.000000000e+00, 1.000000000e+00, 0.000000000e+00],
-    [0.000000000e+00, 0.000000000e+00, 0.000000000e+00, 1.000000000e+00],
-];
-const CHECKER_UVS: &[[f32; 2]] = &[
-    [1.000000000e-01, 1.000000000e-01],
-    [6.000000000e-01, 3.000000000e-01],
-    [-3.000000000e-01, 1.200000000e+00],
-    [1.250000000e-01, 1.666666667e-01],
-    [9.900000000e-01, 5.100000000e-01],
-    [1.700000000e+00, -4.500000000e-01],
-    [5.000000000e-01, 5.000000000e-01],
-    [2.500000000e-01, 7.500000000e-01],
-    [7.500000000e-01, 7.500000000e-01],
-    [5.000000000e-01, 2.500000000e-01],
-    [0.000000000e+00, 0.000000000e+00],
-    [5.000000000e-01, 5.000000000e-01],
-    [5.000100000e-01, 4.999900000e-01],
-];
-// checkerboard default
-const CHECKER_DEFAULT: &[[f32; 3]] = &[
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [2.000000030e-01, 2.000000030e-01, 2.000000030e-01],
-    [2.000000030e-01, 2.000000030e-01, 2.000000030e-01],
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [2.000000030e-01, 2.000000030e-01, 2.000000030e-01],
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [4.000000060e-01, 4.000000060e-01, 4.000000060e-01],
-    [2.000000030e-01, 2.000000030e-01, 2.000000030e-01],
-];
-// checkerboard custom
-const CHECKER_CUSTOM: &[[f32; 3]] = &[
-    [8.999999762e-01, 5.000000000e-01, 1.000000015e-01],
-    [8.999999762e-01, 5.000000000e-01, 1.000000015e-01],
-    [5.000000075e-02, 1.000000015e-01, 6.999999881e-01],
-    [8.999999762e-01, 5.000000000e-01, 1.000000015e-01],
-    [8.999999762e-01, 5.000000000e-01, 1.000000015e-01],
-    [8.999999762e-01, 5.000000000e-01, 1.000000015e-01],
-    [5.000000075e-02, 1.000000015e-01, 6.999999881e-01],
-    [5.000000075e-02, 1.000000015e-01, 6.999999881e-01],
-    [8.999999762e-01, 5.000000000e-01, 1.000000015e-01],
-    [8.999999762e-01, 5.000000000e-01, 1.000000015e-01],
-    [8.999999762e-01, 5.000000000e-01, 1.000000015e-01],
-    [5.000000075e-02, 1.000000015e-01, 6.999999881e-01],
-    [5.000000075e-02, 1.000000015e-01, 6.999999881e-01],
-];
-const BITMAP_UV_MATRIX: [[f64; 4]; 4] = [
-    [2.000000000e+00, 0.000000000e+00, 0.000000000e+00, 6.000000238e-01],
-    [0.000000000e+00, 5.000000000e-01, 0.000000000e+00, 0.000000000e+00],
-    [0.000000000e+00, 0.000000000e+00, 1.000000000e+00, 0.000000000e+00],
-    [0.000000000e+00, 0.000000000e+00, 0.000000000e+00, 1.000000000e+00],
-];
-// bitmap tex_rgb8.png {'filter_type': 'bilinear', 'wrap_mode': 'repeat'}: mean = 2.684369385e-01
-const BITMAP_BILINEAR_REPEAT: &[[f32; 3]] = &[
-    [5.422353745e-02, 1.487350166e-01, 1.685030572e-02],
-    [2.070297152e-01, 7.932554930e-02, 2.998420969e-02],
-    [3.107348680e-01, 2.507796139e-02, 1.207843050e-02],
-    [3.035269910e-03, 6.995401811e-03, 1.517634955e-03],
-    [2.794518173e-01, 2.036569268e-01, 1.046224385e-01],
-    [3.107349277e-01, 2.670017481e-01, 1.590709090e-01],
-    [1.422369778e-01, 1.878207624e-01, 5.067041516e-02],
-];
-// bitmap tex_rgb8.png {'filter_type': 'bilinear', 'wrap_mode': 'mirror'}: mean = 2.684369385e-01
-const BITMAP_BILINEAR_MIRROR: &[[f32; 3]] = &[
-    [3.035269910e-03, 6.995399017e-03, 1.517634955e-03],
-    [2.070297152e-01, 7.932554930e-02, 2.998420969e-02],
-    [4.378283024e-02, 6.629061699e-01, 5.133412778e-02],
-    [3.035269910e-03, 6.995401811e-03, 1.517634955e-03],
-    [5.149178505e-01, 2.036569268e-01, 1.924524754e-01],
-    [4.378281906e-02, 1.606969535e-01, 1.439088490e-02],
-    [1.422369778e-01, 1.878207624e-01, 5.067041516e-02],
-];
-// bitmap tex_rgb8.png {'filter_type': 'bilinear', 'wrap_mode': 'clamp'}: mean = 2.684369385e-01
-const BITMAP_BILINEAR_CLAMP: &[[f32; 3]] = &[
-    [3.035269910e-03, 6.995399017e-03, 1.517634955e-03],
-    [2.070297152e-01, 7.932554930e-02, 2.998420969e-02],
-    [3.035269678e-03, 7.156935334e-01, 1.517634839e-03],
-    [3.035269910e-03, 6.995401811e-03, 1.517634955e-03],
-    [5.149178505e-01, 2.036569268e-01, 1.924524754e-01],
-    [5.149178505e-01, 6.995399483e-03, 1.517635072e-03],
-    [1.422369778e-01, 1.878207624e-01, 5.067041516e-02],
-];
-// bitmap tex_rgb8.png {'filter_type': 'nearest', 'wrap_mode': 'repeat'}: mean = 2.684369385e-01
-const BITMAP_NEAREST_REPEAT: &[[f32; 3]] = &[
-    [3.035269910e-03, 6.995399017e-03, 1.517634955e-03],
-    [2.232278883e-01, 6.995399017e-03, 1.517634955e-03],
-    [2.232278883e-01, 6.995399017e-03, 1.517634955e-03],
-    [3.035269910e-03, 6.995399017e-03, 1.517634955e-03],
-    [5.149178505e-01, 1.878207624e-01, 1.746473908e-01],
-    [2.232278883e-01, 1.878207624e-01, 7.818747312e-02],
-    [2.232278883e-01, 1.878207624e-01, 7.818747312e-02],
-];
-// bitmap tex_rgb8.png {'filter_type': 'nearest', 'wrap_mode': 'mirror'}: mean = 2.684369385e-01
-const BITMAP_NEAREST_MIRROR: &[[f32; 3]] = &[
-    [3.035269910e-03, 6.995399017e-03, 1.517634955e-03],
-    [2.232278883e-01, 6.995399017e-03, 1.517634955e-03],
-    [6.124606729e-02, 7.156935930e-01, 7.818747312e-02],
-    [3.035269910e-03, 6.995399017e-03, 1.517634955e-03],
-    [5.149178505e-01, 1.878207624e-01, 1.746473908e-01],
-    [6.124606729e-02, 1.878207624e-01, 2.315335535e-02],
-    [2.232278883e-01, 1.878207624e-01, 7.818747312e-02],
-];
-// bitmap tex_rgb8.png {'filter_type': 'nearest', 'wrap_mode': 'clamp'}: mean = 2.684369385e-01
-const BITMAP_NEAREST_CLAMP: &[[f32; 3]] = &[
-    [3.035269910e-03, 6.995399017e-03, 1.517634955e-03],
-    [2.232278883e-01, 6.995399017e-03, 1.517634955e-03],
-    [3.035269910e-03, 7.156935930e-01, 1.517634955e-03],
-    [3.035269910e-03, 6.995399017e-03, 1.517634955e-03],
-    [5.149178505e-01, 1.878207624e-01, 1.746473908e-01],
-    [5.149178505e-01, 6.995399017e-03, 1.517634955e-03],
-    [2.232278883e-01, 1.878207624e-01, 7.818747312e-02],
-];
-// bitmap tex_rgb8.png {'raw': True}: mean = 4.370687306e-01
-const BITMAP_RAW: &[[f32; 3]] = &[
-    [1.098039374e-01, 2.352941036e-01, 3.701961040e-02],
-    [4.862745702e-01, 2.352941483e-01, 1.298823804e-01],
-    [5.803921819e-01, 1.176471263e-01, 5.298044160e-02],
-    [3.921568766e-02, 7.843138278e-02, 1.960784383e-02],
-    [4.203921258e-01, 4.823529422e-01, 2.617183924e-01],
-    [5.803922415e-01, 5.294118524e-01, 4.033922553e-01],
-    [3.921568990e-01, 4.705882668e-01, 2.372549176e-01],
-];
-// bitmap tex_rgb8.png {'to_uv': 'BITMAP_UV_MATRIX'}: mean = 2.684369385e-01
-const BITMAP_TO_UV: &[[f32; 3]] = &[
-    [4.274108708e-01, 2.550398111e-01, 2.226309031e-01],
-    [4.274109602e-01, 4.243027419e-02, 3.310522065e-02],
-    [2.589765787e-01, 3.461826444e-01, 1.771080941e-01],
-    [4.857488871e-01, 1.841699481e-01, 1.819359064e-01],
-    [1.940711141e-01, 5.491411686e-02, 1.921000890e-02],
-    [2.589765787e-01, 6.233158708e-01, 3.329028189e-01],
-    [2.070297301e-01, 5.220174044e-02, 1.930924319e-02],
-];
-// bitmap tex_y_float.exr: mean = 1.000000000e+00
-const BITMAP_TEX_Y_FLOAT: &[[f32; 3]] = &[
-    [6.499999762e-01, 6.499999762e-01, 6.499999762e-01],
-    [6.750000715e-01, 6.750000715e-01, 6.750000715e-01],
-    [7.499998808e-01, 7.499998808e-01, 7.499998808e-01],
-    [4.791666269e-01, 4.791666269e-01, 4.791666269e-01],
-    [1.034999967e+00, 1.034999967e+00, 1.034999967e+00],
-    [1.250000119e+00, 1.250000119e+00, 1.250000119e+00],
-    [1.000000000e+00, 1.000000000e+00, 1.000000000e+00],
-];
-// bitmap tex_rgba_float.exr: mean = 1.501917988e-01
-const BITMAP_TEX_RGBA_FLOAT: &[[f32; 3]] = &[
-    [3.999999911e-02, 1.099999994e-01, 3.000000119e-01],
-    [1.300000101e-01, 7.000000030e-02, 3.000000119e-01],
-    [1.599999964e-01, 6.999997795e-02, 3.000000119e-01],
-    [2.500000037e-02, 8.333332092e-02, 3.000000119e-01],
-    [1.059999913e-01, 1.539999992e-01, 3.000000119e-01],
-    [1.600000411e-01, 1.700000167e-01, 3.000000119e-01],
-    [1.000000015e-01, 1.500000060e-01, 3.000000119e-01],
-];
+/// Mitsuba's values (`tests/data/textures.json`, from `scripts/emitter_expected.py`).
+fn mitsuba_values() -> Json {
+    mitsuba_json("textures.json")
+}
 
 #[test]
 fn checkerboard_matches_mitsuba() {
+    let m = mitsuba_values();
     let t = texture("checkerboard", vec![]);
-    check_values(&t, CHECKER_UVS, CHECKER_DEFAULT, 1e-6, "checkerboard default");
+    check_values(&t, &m["checker_uvs"], &m["checker_default"], 1e-6, "checkerboard default");
     assert!((t.mean() - Spectrum::splat(0.3)).abs().max_element() < 1e-6);
     let t = texture(
         "checkerboard",
         vec![
             ("color0", Value::Rgb([0.9, 0.5, 0.1].into())),
             ("color1", Value::Rgb([0.05, 0.1, 0.7].into())),
-            ("to_uv", transform(CHECKER_TO_UV)),
+            ("to_uv", transform(rows4(&m["checker_to_uv"]))),
         ],
     );
-    check_values(&t, CHECKER_UVS, CHECKER_CUSTOM, 1e-6, "checkerboard custom");
+    check_values(&t, &m["checker_uvs"], &m["checker_custom"], 1e-6, "checkerboard custom");
 }
 
 #[test]
@@ -275,37 +104,36 @@ fn nested_checkerboard_evaluates_inner_texture_at_the_same_uv() {
 
 #[test]
 fn bitmap_png_matches_mitsuba() {
-    let cases: &[(&str, &str, &[[f32; 3]])] = &[
-        ("bilinear", "repeat", BITMAP_BILINEAR_REPEAT),
-        ("bilinear", "mirror", BITMAP_BILINEAR_MIRROR),
-        ("bilinear", "clamp", BITMAP_BILINEAR_CLAMP),
-        ("nearest", "repeat", BITMAP_NEAREST_REPEAT),
-        ("nearest", "mirror", BITMAP_NEAREST_MIRROR),
-        ("nearest", "clamp", BITMAP_NEAREST_CLAMP),
-    ];
-    for &(ft, wm, want) in cases {
-        let t = texture("bitmap", vec![("filename", s("tex_rgb8.png")), ("filter_type", s(ft)), ("wrap_mode", s(wm))]);
-        check_values(&t, UVS, want, 1e-3, &format!("bitmap {ft} {wm}"));
-        assert!((luminance(t.mean()) - 2.684369385e-01).abs() < 2e-4, "mean {}", luminance(t.mean()));
+    let m = mitsuba_values();
+    for ft in ["bilinear", "nearest"] {
+        for wm in ["repeat", "mirror", "clamp"] {
+            let t =
+                texture("bitmap", vec![("filename", s("tex_rgb8.png")), ("filter_type", s(ft)), ("wrap_mode", s(wm))]);
+            let want = &m[format!("bitmap_{ft}_{wm}")];
+            check_values(&t, &m["uvs"], &want["values"], 1e-3, &format!("bitmap {ft} {wm}"));
+            assert!((luminance(t.mean()) - num(&want["mean"])).abs() < 2e-4, "mean {}", luminance(t.mean()));
+        }
     }
     let t = texture("bitmap", vec![("filename", s("tex_rgb8.png")), ("raw", Value::Bool(true))]);
-    check_values(&t, UVS, BITMAP_RAW, 1e-3, "bitmap raw");
-    assert!((luminance(t.mean()) - 4.370687306e-01).abs() < 2e-4);
-    let t = texture("bitmap", vec![("filename", s("tex_rgb8.png")), ("to_uv", transform(BITMAP_UV_MATRIX))]);
-    check_values(&t, UVS, BITMAP_TO_UV, 1e-3, "bitmap to_uv");
+    check_values(&t, &m["uvs"], &m["bitmap_raw"]["values"], 1e-3, "bitmap raw");
+    assert!((luminance(t.mean()) - num(&m["bitmap_raw"]["mean"])).abs() < 2e-4);
+    let to_uv = transform(rows4(&m["bitmap_uv_matrix"]));
+    let t = texture("bitmap", vec![("filename", s("tex_rgb8.png")), ("to_uv", to_uv)]);
+    check_values(&t, &m["uvs"], &m["bitmap_to_uv"]["values"], 1e-3, "bitmap to_uv");
 }
 
 #[test]
 fn bitmap_exr_matches_mitsuba() {
+    let m = mitsuba_values();
     let t = texture("bitmap", vec![("filename", s("tex_y_float.exr"))]);
-    check_values(&t, UVS, BITMAP_TEX_Y_FLOAT, 1e-5, "bitmap Y float");
-    assert!((luminance(t.mean()) - 1.0).abs() < 1e-5);
+    check_values(&t, &m["uvs"], &m["bitmap_tex_y_float"]["values"], 1e-5, "bitmap Y float");
+    assert!((luminance(t.mean()) - num(&m["bitmap_tex_y_float"]["mean"])).abs() < 1e-5);
     let t = texture(
         "bitmap",
         vec![("filename", s("tex_rgba_float.exr")), ("format", s("variant")), ("accel", Value::Bool(false))],
     );
-    check_values(&t, UVS, BITMAP_TEX_RGBA_FLOAT, 1e-5, "bitmap RGBA float");
-    assert!((luminance(t.mean()) - 1.501917988e-01).abs() < 1e-6);
+    check_values(&t, &m["uvs"], &m["bitmap_tex_rgba_float"]["values"], 1e-5, "bitmap RGBA float");
+    assert!((luminance(t.mean()) - num(&m["bitmap_tex_rgba_float"]["mean"])).abs() < 1e-6);
 }
 
 #[test]

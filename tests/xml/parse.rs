@@ -1,15 +1,11 @@
 //! The XML parser on valid scenes: every property type, parameters, includes, paths, references,
 //! aliases, version upgrade, and transform / spectrum values compared with Mitsuba 3.9.1.
 
+use crate::data_dir;
 use glam::{DMat4, DVec3};
 use snee::scene::desc::{ObjectDesc, PluginKind, Prop, SpectrumValue, Value};
 use snee::scene::xml::{parse_file, parse_str, ParsedScene};
-use std::path::{Path, PathBuf};
 use std::rc::Rc;
-
-fn data_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xml")
-}
 
 fn defines(d: &[(&str, &str)]) -> Vec<(String, String)> {
     d.iter().map(|(a, b)| (a.to_string(), b.to_string())).collect()

@@ -2,16 +2,12 @@
 //! inserted tags, random attribute values, deep nesting) must give `Ok` or `Err`, never a panic.
 //!
 //! The default run is short; for a long run:
-//! `PROPTEST_CASES=1000000 FUZZ_MAX_MUTATIONS=10 cargo test --release --test fuzz_xml -- --nocapture`.
+//! `PROPTEST_CASES=1000000 FUZZ_MAX_MUTATIONS=10 cargo test --release --test xml fuzz -- --nocapture`.
 
+use crate::data_dir;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use snee::scene::xml::parse_str;
-use std::path::{Path, PathBuf};
-
-fn data_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/xml")
-}
 
 /// Valid scenes covering every tag and most attribute forms.
 const SEEDS: &[&str] = &[
@@ -242,5 +238,5 @@ fn mutated_scenes_never_panic() {
         })
         .unwrap();
     let (oks, errors) = (oks.get(), errors.get());
-    eprintln!("fuzz_xml: {} inputs, {oks} parsed, {errors} rejected with an error", oks + errors);
+    eprintln!("xml fuzz: {} inputs, {oks} parsed, {errors} rejected with an error", oks + errors);
 }

@@ -3,14 +3,9 @@
 //! stands in for a small machine). Each exits non-zero with a message naming the parameter and,
 //! for scene input, its `file:line:col`.
 
+use crate::snee;
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn snee() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_snee"));
-    c.current_dir(env!("CARGO_MANIFEST_DIR"));
-    c
-}
+use std::process::Output;
 
 fn out_dir(name: &str) -> PathBuf {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/test-output/refusals").join(name);

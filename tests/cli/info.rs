@@ -1,15 +1,10 @@
 //! `snee info` speaks in the scene's words: plugin and parameter names as in the XML, colours
 //! as numbers, no Rust debug text (`Some("smoke")`, `Volpath`, `Hg { g: 0.5 }`).
 
-use std::process::Command;
+use crate::snee;
 
 fn info(args: &[&str]) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_snee"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .arg("info")
-        .args(args)
-        .output()
-        .unwrap();
+    let o = snee().arg("info").args(args).output().unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     String::from_utf8(o.stdout).unwrap()
 }

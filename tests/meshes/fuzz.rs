@@ -11,7 +11,7 @@ use snee::shape::obj::load_obj_from_bytes;
 use snee::shape::serialized::load_serialized_from_bytes;
 
 fn cases() -> u32 {
-    std::env::var("SNEE_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(20000)
+    crate::fuzz_cases(20000)
 }
 
 const OBJ: &str = "# base\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nvt 0 0\nvt 1 0\nvt 1 1\n\

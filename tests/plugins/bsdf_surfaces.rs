@@ -4,27 +4,15 @@
 //! - chi-square tests of every sampling routine against its pdf;
 //! - sample weights against eval / pdf.
 
+use crate::{beckmann_visible_pdf_scale, bsdf_desc, close, load_bsdf, mitsuba_json, num, vec3};
 use snee::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use snee::color::Spectrum;
 use snee::math::{DVec3, Vec2, Vec3};
-use snee::scene::desc::{ObjectDesc, PluginKind, Props, Value};
+use snee::scene::desc::{ObjectDesc, Value};
 use snee::scene::resolver::FileResolver;
-use snee::scene::SrcPos;
 use snee::testing::chi2::{chi2_sphere, sidak};
 use snee::testing::{push_alpha, si_with_wi, sph};
 use std::rc::Rc;
-
-fn pos() -> SrcPos {
-    SrcPos::new("test.xml", 1, 1)
-}
-
-fn desc(plugin: &str, props: Vec<(String, Value)>) -> ObjectDesc {
-    let mut p = Props::new(PluginKind::Bsdf, plugin, pos());
-    for (name, v) in props {
-        p.push(&name, v, pos()).unwrap();
-    }
-    ObjectDesc { kind: PluginKind::Bsdf, plugin: plugin.to_string(), id: None, pos: pos(), props: p }
-}
 
 /// A configuration of the JSON file → object description.
 fn desc_from_json(cfg: &serde_json::Value) -> ObjectDesc {
@@ -41,22 +29,9 @@ fn desc_from_json(cfg: &serde_json::Value) -> ObjectDesc {
             serde_json::Value::Object(o) => Value::Object(Rc::new(desc_from_json(&o["bsdf"]))),
             other => panic!("unexpected parameter {other}"),
         };
-        props.push((name.clone(), value));
+        props.push((name.as_str(), value));
     }
-    desc(plugin, props)
-}
-
-fn load(plugin: &str, props: Vec<(&str, Value)>) -> Bsdf {
-    let props = props.into_iter().map(|(n, v)| (n.to_string(), v)).collect();
-    Bsdf::from_desc(&desc(plugin, props), &FileResolver::default()).unwrap()
-}
-
-fn v3(v: &serde_json::Value) -> Vec3 {
-    Vec3::new(v[0].as_f64().unwrap() as f32, v[1].as_f64().unwrap() as f32, v[2].as_f64().unwrap() as f32)
-}
-
-fn f(v: &serde_json::Value) -> f32 {
-    v.as_f64().unwrap() as f32
+    bsdf_desc(plugin, props)
 }
 
 /// |a − b| ≤ abs + rel · max(|a|, |b|), per channel.
@@ -64,16 +39,11 @@ fn close3(a: Spectrum, b: Spectrum, rel: f32, abs: f32) -> bool {
     (a - b).abs().cmple(Spectrum::splat(abs) + rel * a.abs().max(b.abs())).all()
 }
 
-fn close(a: f32, b: f32, rel: f32, abs: f32) -> bool {
-    (a - b).abs() <= abs + rel * a.abs().max(b.abs())
-}
-
 // ---- Point values against Mitsuba ----
 
 #[test]
 fn point_values_match_mitsuba() {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/bsdf_surfaces.json")).unwrap();
-    let data: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let data = mitsuba_json("bsdf_surfaces.json");
     // Tolerances: f32 arithmetic in a different order (and, for roughplastic, tables integrated with
     // f64 sums); Beckmann's visible-normal sampler iterates Newton steps, which amplifies rounding.
     let (rel, abs) = (5e-4, 1e-6);
@@ -95,21 +65,21 @@ fn point_values_match_mitsuba() {
             let comp = c["component"].as_i64().unwrap();
             let ctx =
                 BsdfContext { mode, type_mask: flags::ALL, component: if comp < 0 { u32::MAX } else { comp as u32 } };
-            let si = si_with_wi(v3(&c["wi"]));
+            let si = si_with_wi(vec3(&c["wi"]));
             let tag = format!("{name} case {k} (wi {:?}, ctx {:?})", si.wi, ctx);
 
             let nt = bsdf.eval_null_transmission(&si);
-            if !close3(nt, v3(&c["null_transmission"]), 1e-5, 1e-6) {
-                failures.push(format!("{tag}: null transmission {nt} vs {}", v3(&c["null_transmission"])));
+            if !close3(nt, vec3(&c["null_transmission"]), 1e-5, 1e-6) {
+                failures.push(format!("{tag}: null transmission {nt} vs {}", vec3(&c["null_transmission"])));
             }
 
             for e in c["evals"].as_array().unwrap() {
-                let wo = v3(&e["wo"]);
+                let wo = vec3(&e["wo"]);
                 let (value, pdf) = bsdf.eval_pdf(&ctx, &si, wo);
-                let (m_value, m_pdf) = (v3(&e["eval"]), f(&e["pdf"]));
+                let (m_value, m_pdf) = (vec3(&e["eval"]), num(&e["pdf"]));
                 // Mitsuba's eval_pdf and eval/pdf alone agree except where its eval_pdf leaves a pdf
                 // unmasked; compare with `eval` and `pdf` alone.
-                let (m_value_alone, m_pdf_alone) = (v3(&e["eval_alone"]), f(&e["pdf_alone"]));
+                let (m_value_alone, m_pdf_alone) = (vec3(&e["eval_alone"]), num(&e["pdf_alone"]));
                 if !close3(value, m_value_alone, rel, abs) || !close3(value, m_value, rel, abs) {
                     failures.push(format!("{tag}: eval at {wo} = {value} vs Mitsuba {m_value_alone}"));
                 }
@@ -122,12 +92,12 @@ fn point_values_match_mitsuba() {
                 checked[0] += 1;
             }
 
-            let s1 = f(&c["sample1"]);
-            let s2 = Vec2::new(f(&c["sample2"][0]), f(&c["sample2"][1]));
-            let m_weight = v3(&c["s_weight"]);
+            let s1 = num(&c["sample1"]);
+            let s2 = Vec2::new(num(&c["sample2"][0]), num(&c["sample2"][1]));
+            let m_weight = vec3(&c["s_weight"]);
             match bsdf.sample(&ctx, &si, s1, s2) {
                 None => {
-                    if m_weight.max_element() > 0.0 && f(&c["s_pdf"]) > 0.0 {
+                    if m_weight.max_element() > 0.0 && num(&c["s_pdf"]) > 0.0 {
                         failures.push(format!("{tag}: no sample, Mitsuba has weight {m_weight}"));
                     }
                 }
@@ -136,16 +106,16 @@ fn point_values_match_mitsuba() {
                         failures.push(format!("{tag}: sample with weight {w}, Mitsuba's weight is 0"));
                         continue;
                     }
-                    let ok = (bs.wo - v3(&c["s_wo"])).length() < 2e-5
-                        && close(bs.pdf, f(&c["s_pdf"]), rel, abs)
+                    let ok = (bs.wo - vec3(&c["s_wo"])).length() < 2e-5
+                        && close(bs.pdf, num(&c["s_pdf"]), rel, abs)
                         && close3(w, m_weight, rel, abs)
                         && bs.sampled_type == c["s_type"].as_u64().unwrap() as u32
                         && bs.sampled_component == c["s_component"].as_u64().unwrap() as u32
-                        && bs.eta == f(&c["s_eta"]);
+                        && bs.eta == num(&c["s_eta"]);
                     if !ok {
                         failures.push(format!(
                             "{tag}: sample (wo {}, pdf {}, weight {}, type {}, comp {}) vs Mitsuba (wo {}, pdf {}, weight {}, type {}, comp {})",
-                            bs.wo, bs.pdf, w, bs.sampled_type, bs.sampled_component, v3(&c["s_wo"]), f(&c["s_pdf"]),
+                            bs.wo, bs.pdf, w, bs.sampled_type, bs.sampled_component, vec3(&c["s_wo"]), num(&c["s_pdf"]),
                             m_weight, c["s_type"], c["s_component"]
                         ));
                     }
@@ -216,19 +186,6 @@ fn chi2_smooth_res(
     )
 }
 
-/// Mitsuba's Beckmann masking G1 is a rational fit (< 0.35 % error) while its visible-normal
-/// sampler inverts the exact distribution: the density of sampled normals is the pdf divided by
-/// K = G1_fit(wi) / G1_exact(wi) (see tests/chi2_bsdf.rs). K = 1 for GGX.
-fn beckmann_visible_k(alpha_u: f32, alpha_v: f32, wi: Vec3) -> f64 {
-    use snee::bsdf::microfacet::{erf, MicrofacetDistribution, MicrofacetType};
-    let distr = MicrofacetDistribution::new(MicrofacetType::Beckmann, alpha_u, alpha_v, true);
-    let g1_fit = distr.smith_g1(wi, Vec3::Z) as f64;
-    let (x, y, z) = (wi.x as f64, wi.y as f64, wi.z as f64);
-    let a = z / ((alpha_u as f64 * x).powi(2) + (alpha_v as f64 * y).powi(2)).sqrt();
-    let g1_exact = 2.0 / (1.0 + erf(a as f32) as f64 + (-a * a).exp() / (a * std::f64::consts::PI.sqrt()));
-    g1_fit / g1_exact
-}
-
 fn rough_conductor(ggx: bool, alpha_u: f32, alpha_v: f32, visible: bool) -> Bsdf {
     let mut p = vec![
         ("distribution", Value::String(if ggx { "ggx" } else { "beckmann" }.into())),
@@ -236,11 +193,11 @@ fn rough_conductor(ggx: bool, alpha_u: f32, alpha_v: f32, visible: bool) -> Bsdf
         ("sample_visible", Value::Bool(visible)),
     ];
     push_alpha(&mut p, alpha_u, alpha_v);
-    load("roughconductor", p)
+    load_bsdf("roughconductor", p)
 }
 
 fn rough_plastic(ggx: bool, alpha: f32, visible: bool, int_ior: f32) -> Bsdf {
-    load(
+    load_bsdf(
         "roughplastic",
         vec![
             ("distribution", Value::String(if ggx { "ggx" } else { "beckmann" }.into())),
@@ -268,7 +225,7 @@ fn chi2_rough_conductor() {
                 for &theta in &THETAS {
                     seed += 1;
                     let wi = sph(theta, 20.0 + theta);
-                    let k = if visible && !ggx { beckmann_visible_k(au, av, wi) } else { 1.0 };
+                    let k = if visible && !ggx { beckmann_visible_pdf_scale(au, av, wi) } else { 1.0 };
                     let res_phi = lobe_res_phi(au.min(av), wi);
                     let r = chi2_smooth_res(&bsdf, &BsdfContext::default(), wi, k, res_phi, significance, seed);
                     if !r.passed || r.pdf_integral > 1.0 + 1e-3 {
@@ -306,7 +263,7 @@ fn chi2_rough_plastic() {
             let wi = sph(theta, 40.0 + theta);
             let beckmann_visible = visible && !ggx;
             let (ctx, k) = if beckmann_visible {
-                (BsdfContext { component: 0, ..Default::default() }, beckmann_visible_k(alpha, alpha, wi))
+                (BsdfContext { component: 0, ..Default::default() }, beckmann_visible_pdf_scale(alpha, alpha, wi))
             } else {
                 (BsdfContext::default(), 1.0)
             };
@@ -327,17 +284,15 @@ fn chi2_rough_plastic() {
 /// mass: ∫ pdf = opacity × the nested integral).
 #[test]
 fn chi2_plastic_and_mask() {
-    let plastic = load(
+    let plastic = load_bsdf(
         "plastic",
         vec![("diffuse_reflectance", Value::Rgb(DVec3::new(0.3, 0.6, 0.2))), ("int_ior", Value::Float(1.7))],
     );
-    let diffuse = desc("diffuse", vec![]);
-    let mask_diffuse = load("mask", vec![("opacity", Value::Float(0.3)), ("m", Value::Object(Rc::new(diffuse)))]);
-    let inner = desc(
-        "roughconductor",
-        vec![("distribution".into(), Value::String("ggx".into())), ("alpha".into(), Value::Float(0.25))],
-    );
-    let mask_metal = load("mask", vec![("opacity", Value::Float(0.7)), ("m", Value::Object(Rc::new(inner)))]);
+    let diffuse = bsdf_desc("diffuse", vec![]);
+    let mask_diffuse = load_bsdf("mask", vec![("opacity", Value::Float(0.3)), ("m", Value::Object(Rc::new(diffuse)))]);
+    let inner =
+        bsdf_desc("roughconductor", vec![("distribution", Value::String("ggx".into())), ("alpha", Value::Float(0.25))]);
+    let mask_metal = load_bsdf("mask", vec![("opacity", Value::Float(0.7)), ("m", Value::Object(Rc::new(inner)))]);
     let cases: [(&Bsdf, f64); 3] = [(&plastic, -1.0), (&mask_diffuse, 0.3), (&mask_metal, -1.0)];
     let significance = sidak(0.01, cases.len() * THETAS.len());
     let mut failures = Vec::new();
@@ -364,9 +319,12 @@ fn sample_weight_is_eval_over_pdf() {
         rough_conductor(true, 0.3, 0.1, false),
         rough_plastic(true, 0.2, true, 1.5),
         rough_plastic(false, 0.3, false, 1.9),
-        load("plastic", vec![("nonlinear", Value::Bool(true))]),
-        load("conductor", vec![("material", Value::String("Au".into()))]),
-        load("mask", vec![("opacity", Value::Float(0.5)), ("m", Value::Object(Rc::new(desc("diffuse", vec![]))))]),
+        load_bsdf("plastic", vec![("nonlinear", Value::Bool(true))]),
+        load_bsdf("conductor", vec![("material", Value::String("Au".into()))]),
+        load_bsdf(
+            "mask",
+            vec![("opacity", Value::Float(0.5)), ("m", Value::Object(Rc::new(bsdf_desc("diffuse", vec![]))))],
+        ),
     ];
     let mut rng = snee::sampler::Sampler::new(7, 0);
     for (i, bsdf) in bsdfs.iter().enumerate() {
@@ -399,8 +357,7 @@ fn sample_weight_is_eval_over_pdf() {
 #[test]
 fn parameters_and_errors() {
     let err = |plugin: &str, props: Vec<(&str, Value)>| -> String {
-        let props = props.into_iter().map(|(n, v)| (n.to_string(), v)).collect();
-        match Bsdf::from_desc(&desc(plugin, props), &FileResolver::default()) {
+        match Bsdf::from_desc(&bsdf_desc(plugin, props), &FileResolver::default()) {
             Ok(b) => panic!("{plugin}: expected an error, got {b:?}"),
             Err(e) => e.msg,
         }
@@ -419,16 +376,16 @@ fn parameters_and_errors() {
     assert!(err("plastic", vec![("roughness", Value::Float(0.1))]).contains("roughness"));
     assert!(err("mask", vec![("opacity", Value::Float(0.5))]).contains("nested BSDF is required"));
     let two = vec![
-        ("a", Value::Object(Rc::new(desc("diffuse", vec![])))),
-        ("b", Value::Object(Rc::new(desc("diffuse", vec![])))),
+        ("a", Value::Object(Rc::new(bsdf_desc("diffuse", vec![])))),
+        ("b", Value::Object(Rc::new(bsdf_desc("diffuse", vec![])))),
     ];
     assert!(err("mask", two).contains("more than one"));
 
     // Defaults: conductor = perfect mirror; plastic and roughplastic = polypropylene (1.49) over air.
     let si = si_with_wi(sph(30.0, 0.0));
-    let (_, w) = load("conductor", vec![]).sample(&BsdfContext::default(), &si, 0.5, Vec2::splat(0.5)).unwrap();
+    let (_, w) = load_bsdf("conductor", vec![]).sample(&BsdfContext::default(), &si, 0.5, Vec2::splat(0.5)).unwrap();
     assert!((w - Spectrum::ONE).abs().max_element() < 1e-6);
-    match load("roughplastic", vec![]) {
+    match load_bsdf("roughplastic", vec![]) {
         Bsdf::RoughPlastic(p) => {
             assert!((p.eta - 1.49 / 1.000277).abs() < 1e-6 && p.alpha == 0.1 && p.sample_visible);
             assert_eq!(p.distribution, snee::bsdf::microfacet::MicrofacetType::Beckmann);
@@ -436,7 +393,7 @@ fn parameters_and_errors() {
         other => panic!("{other:?}"),
     }
     // An <rgb> index of refraction may exceed 1 (unlike reflectances).
-    load(
+    load_bsdf(
         "conductor",
         vec![("eta", Value::Rgb(DVec3::new(0.2, 0.9, 1.1))), ("k", Value::Rgb(DVec3::new(3.9, 2.4, 2.1)))],
     );

@@ -3,14 +3,14 @@
 //! error naming the file, never a panic (or an allocation the file cannot back).
 //!
 //! Cases per property default to 30000 (about 1-2 s); set `SNEE_FUZZ_CASES` for a long run:
-//! `SNEE_FUZZ_CASES=1000000 cargo test --release --test fuzz_ply`.
+//! `SNEE_FUZZ_CASES=1000000 cargo test --release --test meshes fuzz_ply`.
 
 use proptest::prelude::*;
 use proptest::sample::Index;
 use snee::shape::ply::load_ply_from_bytes;
 
 fn cases() -> u32 {
-    std::env::var("SNEE_FUZZ_CASES").ok().and_then(|s| s.parse().ok()).unwrap_or(30000)
+    crate::fuzz_cases(30000)
 }
 
 /// Valid base files: ascii, binary little and big endian, with normals, uvs, polygons, ignored

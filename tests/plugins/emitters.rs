@@ -1,7 +1,7 @@
 //! Emitters against Mitsuba 3.9 and their samplers against their pdfs.
 //!
-//! The reference numbers come from `scripts/emitter_expected.py` (which also writes the images in
-//! `tests/data/`), e.g. for the envmap:
+//! The reference numbers are in `tests/data/emitters.json`, written by `scripts/emitter_expected.py`
+//! (which also writes the images in `tests/data/`), e.g. for the envmap:
 //!
 //! ```python
 //! env = mi.load_dict({"type": "envmap", "filename": "tests/data/envmap_half_piz.exr", "scale": 1.5,
@@ -10,9 +10,8 @@
 //! ```
 //! and for the delta lights `emitter.sample_direction(it, [0.5, 0.5])` with `it.p` the reference point.
 
-// The reference numbers are pasted as Mitsuba printed them (9 significant digits).
-#![allow(clippy::excessive_precision)]
-
+use crate::{data_dir, mitsuba_json, num, rows4, transform, vec3};
+use serde_json::Value as Json;
 use snee::color::{luminance, Spectrum};
 use snee::emitter::{Emitter, EnvironmentEmitter};
 use snee::interaction::DirectionSample;
@@ -21,12 +20,11 @@ use snee::scene::desc::{ObjectDesc, PluginKind, Props, Value};
 use snee::scene::resolver::FileResolver;
 use snee::scene::SrcPos;
 use snee::testing::chi2::{chi2_sphere, sidak};
-use std::path::PathBuf;
 
 // ---- Helpers ----
 
 fn resolver() -> FileResolver {
-    FileResolver { paths: vec![PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data")] }
+    FileResolver { paths: vec![data_dir()] }
 }
 
 fn desc(plugin: &str, props: Vec<(&str, Value)>) -> ObjectDesc {
@@ -42,17 +40,8 @@ fn emitter(plugin: &str, props: Vec<(&str, Value)>) -> Emitter {
     Emitter::from_desc(&desc(plugin, props), &resolver()).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// A transform property from Mitsuba's row-major matrix.
-fn transform(rows: [[f64; 4]; 4]) -> Value {
-    Value::Transform(glam::DMat4::from_cols_array_2d(&rows).transpose())
-}
-
 fn rgb(v: [f64; 3]) -> Value {
     Value::Rgb(glam::DVec3::from_array(v))
-}
-
-fn v3(a: [f32; 3]) -> Vec3 {
-    Vec3::from_array(a)
 }
 
 #[track_caller]
@@ -61,97 +50,10 @@ fn assert_close(got: Vec3, want: Vec3, rel: f32, what: &str) {
     assert!(err <= rel * want.abs().max_element().max(1e-3), "{what}: got {got}, Mitsuba {want}");
 }
 
-// ---- Values from Mitsuba (scripts/emitter_expected.py) ----
-
-const ENV_TO_WORLD: [[f64; 4]; 4] = [
-    [8.660253882e-01, 1.710100621e-01, 4.698463380e-01, 0.000000000e+00],
-    [0.000000000e+00, 9.396926761e-01, -3.420201242e-01, 0.000000000e+00],
-    [-5.000000000e-01, 2.961980999e-01, 8.137977123e-01, 0.000000000e+00],
-    [0.000000000e+00, 0.000000000e+00, 0.000000000e+00, 1.000000000e+00],
-];
-const ENV_EVAL: &[([f32; 3], [f32; 3])] = &[
-    ([0.000000000e+00, 0.000000000e+00, 1.000000000e+00], [1.247785926e+00, 7.532140017e-01, 1.897720456e+00]),
-    ([0.000000000e+00, 1.000000000e+00, 0.000000000e+00], [7.291868329e-01, 5.332844257e-01, 1.591552734e+00]),
-    ([1.000000000e+00, 0.000000000e+00, 0.000000000e+00], [1.076691389e+00, 7.840058804e-01, 1.730533004e+00]),
-    ([-3.030457634e-01, 5.050762723e-01, 8.081220356e-01], [1.124030352e+00, 6.521354318e-01, 1.807229161e+00]),
-    ([6.359987280e-01, -7.419985160e-01, 2.119995760e-01], [1.497988224e+00, 9.573481679e-01, 1.951512575e+00]),
-    ([1.024631039e-01, 9.733994872e-01, -2.049262078e-01], [4.146475196e-01, 5.722451210e-01, 1.506331921e+00]),
-    ([-9.434563530e-01, 1.048284837e-01, -3.144854510e-01], [1.732691050e+00, 8.625009060e-01, 2.333044052e+00]),
-    ([2.009162582e-01, -1.004581291e-01, -9.744438524e-01], [1.144743681e+00, 9.101811647e-01, 1.591013432e+00]),
-    ([3.566604070e-01, 8.356043820e-01, 4.178021910e-01], [6.191703081e-01, 5.086549520e-01, 1.554899931e+00]),
-];
-// tex_rgb8.png as an envmap (sRGB -> linear), identity transform
-const ENV_PNG_EVAL: &[([f32; 3], [f32; 3])] = &[
-    ([0.000000000e+00, 0.000000000e+00, 1.000000000e+00], [1.422369778e-01, 1.878207624e-01, 5.067041144e-02]),
-    ([1.000000000e+00, 0.000000000e+00, 0.000000000e+00], [3.214066848e-02, 1.878207624e-01, 1.233549695e-02]),
-    ([-3.030457634e-01, 5.050762723e-01, 8.081220356e-01], [1.792336553e-01, 1.268697232e-01, 4.243530333e-02]),
-    ([6.359987280e-01, -7.419985160e-01, 2.119995760e-01], [4.406413436e-02, 4.687777162e-01, 3.741284087e-02]),
-    ([1.024631039e-01, 9.733994872e-01, -2.049262078e-01], [1.078856066e-01, 3.360676765e-02, 6.736536510e-03]),
-];
-// spot: cutoff 30, beam 12, intensity (2,3,4), to_world = look_at([1,2,3] -> [1,0,3.5], up z)
-const SPOT_TO_WORLD: [[f64; 4]; 4] = [
-    [1.000000000e+00, 0.000000000e+00, 0.000000000e+00, 1.000000000e+00],
-    [0.000000000e+00, 2.425356358e-01, -9.701425433e-01, 2.000000000e+00],
-    [0.000000000e+00, 9.701425433e-01, 2.425356358e-01, 3.000000000e+00],
-    [0.000000000e+00, 0.000000000e+00, 0.000000000e+00, 1.000000000e+00],
-];
-const SPOT_WEIGHT: &[([f32; 3], [f32; 3])] = &[
-    ([1.000000000e+00, 3.507575989e-01, 3.412310600e+00], [6.920414567e-01, 1.038062215e+00, 1.384082913e+00]),
-    ([1.000000000e+00, 3.507575989e-01, 3.412310600e+00], [6.920414567e-01, 1.038062215e+00, 1.384082913e+00]),
-    ([1.156880334e+00, 2.603884935e-01, 3.434902877e+00], [6.172838807e-01, 9.259258509e-01, 1.234567761e+00]),
-    ([1.041965306e+00, 2.970509529e-01, 3.581552863e+00], [6.172838807e-01, 9.259258509e-01, 1.234567761e+00]),
-    ([1.399623722e+00, 1.602698565e-01, 3.459932536e+00], [5.325034261e-01, 7.987551689e-01, 1.065006852e+00]),
-    ([1.106898874e+00, 2.536607981e-01, 3.833496273e+00], [5.325034261e-01, 7.987551689e-01, 1.065006852e+00]),
-    ([1.422057271e+00, 1.530647278e-01, 3.461733818e+00], [5.113599300e-01, 7.670398951e-01, 1.022719860e+00]),
-    ([1.112899825e+00, 2.516982555e-01, 3.856268227e+00], [5.113599300e-01, 7.670398951e-01, 1.022719860e+00]),
-    ([1.517638087e+00, 1.258285046e-01, 3.468542874e+00], [4.166669548e-01, 6.250004172e-01, 8.333339095e-01]),
-    ([1.138467580e+00, 2.467991114e-01, 3.952425122e+00], [4.166669548e-01, 6.250004172e-01, 8.333339095e-01]),
-    ([1.718242288e+00, 8.556497097e-02, 3.478608757e+00], [2.519527078e-01, 3.779290617e-01, 5.039054155e-01]),
-    ([1.192128956e+00, 2.534161806e-01, 4.150013566e+00], [2.519529164e-01, 3.779293895e-01, 5.039058328e-01]),
-    ([1.929760218e+00, 6.565487385e-02, 3.483586282e+00], [1.147844717e-01, 1.721767038e-01, 2.295689434e-01]),
-    ([1.248709753e+00, 2.829371691e-01, 4.352715611e+00], [1.147844866e-01, 1.721767336e-01, 2.295689732e-01]),
-    ([2.127649903e+00, 6.639480591e-02, 3.483401299e+00], [1.059414633e-02, 1.589122042e-02, 2.118829265e-02]),
-    ([1.301645011e+00, 3.299232721e-01, 4.537515879e+00], [1.059428789e-02, 1.589143276e-02, 2.118857577e-02]),
-    ([2.194888353e+00, 7.074737549e-02, 3.482313156e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
-    ([1.319631219e+00, 3.499894142e-01, 4.599281430e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
-    ([3.511473656e+00, 5.932933092e-01, 3.351676673e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
-    ([1.671816289e+00, 1.180217683e+00, 5.699373960e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
-];
-// spot: cutoff 40 (beam 30), texture tex_rgb8.png, to_world = SPOT_TO_WORLD
-const SPOT_TEXTURED_WEIGHT: &[([f32; 3], [f32; 3])] = &[
-    ([1.000000000e+00, -4.253563881e-01, 3.606339097e+00], [2.275791392e-02, 3.005131520e-02, 8.107264526e-03]),
-    ([1.414731085e+00, -3.573944569e-01, 3.721588373e+00], [3.316377103e-02, 3.791876510e-02, 1.495297998e-02]),
-    ([6.441735029e-01, -9.051918983e-02, 4.324053407e+00], [1.340137888e-02, 8.002010733e-02, 1.257606223e-02]),
-    ([1.570854068e+00, -4.137463570e-01, 2.687022209e+00], [4.040766135e-02, 9.757268243e-03, 4.368503578e-03]),
-    ([1.100004315e-01, -2.839982510e-01, 2.508825243e+00], [3.523127874e-03, 3.242689185e-03, 3.136384184e-04]),
-    ([1.831608236e+00, 4.029138088e-01, 4.734284878e+00], [1.186773740e-02, 1.892802864e-02, 1.442172285e-02]),
-    ([2.767766953e+00, 2.850140333e-01, 3.428746492e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
-];
-// spot with defaults (cutoff 20, beam 15) at the origin, along +z; reference points
-const SPOT_DEFAULT_WEIGHT: &[([f32; 3], [f32; 3])] = &[
-    ([0.000000000e+00, 0.000000000e+00, 2.000000000e+00], [2.500000000e-01, 2.500000000e-01, 2.500000000e-01]),
-    ([3.472963553e-01, 0.000000000e+00, 1.969615506e+00], [2.500000596e-01, 2.500000596e-01, 2.500000596e-01]),
-    ([5.142655863e-01, 0.000000000e+00, 1.932752159e+00], [2.500000000e-01, 2.500000000e-01, 2.500000000e-01]),
-    ([5.512747116e-01, 0.000000000e+00, 1.922523392e+00], [2.000000179e-01, 2.000000179e-01, 2.000000179e-01]),
-    ([6.180339887e-01, 0.000000000e+00, 1.902113033e+00], [1.000002176e-01, 1.000002176e-01, 1.000002176e-01]),
-    ([6.807591004e-01, 0.000000000e+00, 1.880576254e+00], [4.999955650e-03, 4.999955650e-03, 4.999955650e-03]),
-    ([7.167358991e-01, 0.000000000e+00, 1.867160853e+00], [0.000000000e+00, 0.000000000e+00, 0.000000000e+00]),
-];
-// point at (1,2,3), intensity (5,6,7), from (0.3,-0.2,0.5): d, dist, weight
-const POINT: ([f32; 3], f32, [f32; 3]) = (
-    [2.057044953e-01, 6.464998722e-01, 7.346588969e-01],
-    3.402939796e+00,
-    [4.317789972e-01, 5.181347728e-01, 6.044905782e-01],
-);
-// directional towards (1,-2,0.5), irradiance (3,2,1): d, weight
-const DIRECTIONAL: ([f32; 3], [f32; 3]) =
-    ([-4.364358187e-01, 8.728716373e-01, -2.182179093e-01], [3.000000000e+00, 2.000000000e+00, 1.000000000e+00]);
-// constant radiance (0.5,1,2), sample (0.3,0.7): d, pdf, weight
-const CONSTANT: ([f32; 3], f32, [f32; 3]) = (
-    [-2.832189202e-01, 8.716576695e-01, -3.999999762e-01],
-    7.957746834e-02,
-    [6.283185482e+00, 1.256637096e+01, 2.513274193e+01],
-);
+/// Mitsuba's values (`tests/data/emitters.json`, from `scripts/emitter_expected.py`).
+fn mitsuba_values() -> Json {
+    mitsuba_json("emitters.json")
+}
 
 #[test]
 fn envmap_eval_matches_mitsuba() {
@@ -160,20 +62,22 @@ fn envmap_eval_matches_mitsuba() {
         vec![
             ("filename", Value::String("envmap_half_piz.exr".into())),
             ("scale", Value::Float(1.5)),
-            ("to_world", transform(ENV_TO_WORLD)),
+            ("to_world", transform(rows4(&mitsuba_values()["env_to_world"]))),
         ],
     );
     assert!(e.is_environment() && !e.is_delta());
-    for &(d, want) in ENV_EVAL {
-        assert_close(e.eval_environment(v3(d)), v3(want), 1e-4, &format!("envmap eval {d:?}"));
+    for c in mitsuba_values()["env_eval"].as_array().unwrap() {
+        let (d, want) = (vec3(&c["d"]), vec3(&c["value"]));
+        assert_close(e.eval_environment(d), want, 1e-4, &format!("envmap eval {d:?}"));
     }
 }
 
 #[test]
 fn envmap_from_png_matches_mitsuba() {
     let e = emitter("envmap", vec![("filename", Value::String("tex_rgb8.png".into()))]);
-    for &(d, want) in ENV_PNG_EVAL {
-        assert_close(e.eval_environment(v3(d)), v3(want), 1e-4, &format!("envmap (png) eval {d:?}"));
+    for c in mitsuba_values()["env_png_eval"].as_array().unwrap() {
+        let (d, want) = (vec3(&c["d"]), vec3(&c["value"]));
+        assert_close(e.eval_environment(d), want, 1e-4, &format!("envmap (png) eval {d:?}"));
     }
 }
 
@@ -184,22 +88,24 @@ fn spot_matches_mitsuba() {
         vec![
             ("cutoff_angle", Value::Float(30.0)),
             ("beam_width", Value::Float(12.0)),
-            ("to_world", transform(SPOT_TO_WORLD)),
+            ("to_world", transform(rows4(&mitsuba_values()["spot_to_world"]))),
             ("intensity", rgb([2.0, 3.0, 4.0])),
         ],
     );
     assert!(e.is_delta());
-    for &(p, want) in SPOT_WEIGHT {
-        let (ds, w) = e.sample_direction(v3(p), Vec2::splat(0.5));
+    for c in mitsuba_values()["spot_weight"].as_array().unwrap() {
+        let (p, want) = (vec3(&c["ref"]), vec3(&c["weight"]));
+        let (ds, w) = e.sample_direction(p, Vec2::splat(0.5));
         assert!(ds.delta && ds.pdf == 1.0);
         assert!((ds.p - Vec3::new(1.0, 2.0, 3.0)).length() < 1e-5);
-        assert_close(w, v3(want), 1e-4, &format!("spot weight from {p:?}"));
-        assert_eq!(e.pdf_direction(v3(p), &ds), 0.0);
+        assert_close(w, want, 1e-4, &format!("spot weight from {p:?}"));
+        assert_eq!(e.pdf_direction(p, &ds), 0.0);
     }
     let e = emitter("spot", vec![]);
-    for &(p, want) in SPOT_DEFAULT_WEIGHT {
-        let (_, w) = e.sample_direction(v3(p), Vec2::splat(0.5));
-        assert_close(w, v3(want), 1e-4, &format!("default spot weight from {p:?}"));
+    for c in mitsuba_values()["spot_default_weight"].as_array().unwrap() {
+        let (p, want) = (vec3(&c["ref"]), vec3(&c["weight"]));
+        let (_, w) = e.sample_direction(p, Vec2::splat(0.5));
+        assert_close(w, want, 1e-4, &format!("default spot weight from {p:?}"));
     }
 }
 
@@ -213,14 +119,15 @@ fn textured_spot_matches_mitsuba() {
         "spot",
         vec![
             ("cutoff_angle", Value::Float(40.0)),
-            ("to_world", transform(SPOT_TO_WORLD)),
+            ("to_world", transform(rows4(&mitsuba_values()["spot_to_world"]))),
             ("texture", Value::Object(std::rc::Rc::new(tex))),
         ],
     );
-    for &(p, want) in SPOT_TEXTURED_WEIGHT {
-        let (_, w) = e.sample_direction(v3(p), Vec2::splat(0.5));
+    for c in mitsuba_values()["spot_textured_weight"].as_array().unwrap() {
+        let (p, want) = (vec3(&c["ref"]), vec3(&c["weight"]));
+        let (_, w) = e.sample_direction(p, Vec2::splat(0.5));
         // Mitsuba keeps 8-bit textures in half precision.
-        assert_close(w, v3(want), 1e-3, &format!("textured spot weight from {p:?}"));
+        assert_close(w, want, 1e-3, &format!("textured spot weight from {p:?}"));
     }
 }
 
@@ -245,13 +152,14 @@ fn spot_falloff_is_mitsubas_linear_ramp() {
 
 #[test]
 fn point_directional_constant_match_mitsuba() {
+    let m = mitsuba_values();
     let p = Vec3::new(0.3, -0.2, 0.5);
     let e =
         emitter("point", vec![("position", Value::Point([1.0, 2.0, 3.0].into())), ("intensity", rgb([5.0, 6.0, 7.0]))]);
     let (ds, w) = e.sample_direction(p, Vec2::splat(0.5));
-    assert_close(ds.d, v3(POINT.0), 1e-5, "point d");
-    assert!((ds.dist - POINT.1).abs() < 1e-5);
-    assert_close(w, v3(POINT.2), 1e-5, "point weight");
+    assert_close(ds.d, vec3(&m["point"]["d"]), 1e-5, "point d");
+    assert!((ds.dist - num(&m["point"]["dist"])).abs() < 1e-5);
+    assert_close(w, vec3(&m["point"]["weight"]), 1e-5, "point weight");
     assert!(ds.delta && e.is_delta());
 
     let e = emitter(
@@ -259,16 +167,16 @@ fn point_directional_constant_match_mitsuba() {
         vec![("direction", Value::Vector([1.0, -2.0, 0.5].into())), ("irradiance", rgb([3.0, 2.0, 1.0]))],
     );
     let (ds, w) = e.sample_direction(p, Vec2::splat(0.5));
-    assert_close(ds.d, v3(DIRECTIONAL.0), 1e-5, "directional d");
-    assert_close(w, v3(DIRECTIONAL.1), 1e-6, "directional weight");
+    assert_close(ds.d, vec3(&m["directional"]["d"]), 1e-5, "directional d");
+    assert_close(w, vec3(&m["directional"]["weight"]), 1e-6, "directional weight");
     assert!(ds.delta && ds.dist.is_infinite() && e.pdf_direction(p, &ds) == 0.0);
     assert_eq!(e.eval_environment(-ds.d), Spectrum::ZERO);
 
     let e = emitter("constant", vec![("radiance", rgb([0.5, 1.0, 2.0]))]);
     let (ds, w) = e.sample_direction(p, Vec2::new(0.3, 0.7));
-    assert_close(ds.d, v3(CONSTANT.0), 1e-5, "constant d");
-    assert!((ds.pdf - CONSTANT.1).abs() < 1e-7 && (e.pdf_direction(p, &ds) - ds.pdf).abs() < 1e-7);
-    assert_close(w, v3(CONSTANT.2), 1e-6, "constant weight");
+    assert_close(ds.d, vec3(&m["constant"]["d"]), 1e-5, "constant d");
+    assert!((ds.pdf - num(&m["constant"]["pdf"])).abs() < 1e-7 && (e.pdf_direction(p, &ds) - ds.pdf).abs() < 1e-7);
+    assert_close(w, vec3(&m["constant"]["weight"]), 1e-6, "constant weight");
     assert_eq!(e.eval_environment(ds.d), Spectrum::new(0.5, 1.0, 2.0));
 }
 
@@ -300,7 +208,10 @@ fn bad_emitter_descriptions_are_errors_with_positions() {
     assert!(e.starts_with("scene.xml:3:5:") && e.contains("directional, envmap, constant, point, spot"), "{e}");
     let e = err(
         "directional",
-        vec![("direction", Value::Vector([0.0, 0.0, 1.0].into())), ("to_world", transform(ENV_TO_WORLD))],
+        vec![
+            ("direction", Value::Vector([0.0, 0.0, 1.0].into())),
+            ("to_world", transform(rows4(&mitsuba_values()["env_to_world"]))),
+        ],
     );
     assert!(e.starts_with("scene.xml:4:9:") && e.contains("only one of"), "{e}");
     let e = err("directional", vec![("direction", Value::Vector([0.0, 0.0, 0.0].into()))]);
