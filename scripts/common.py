@@ -11,6 +11,7 @@ import json
 import math
 import os
 import struct
+import subprocess
 import sys
 import time
 import zlib
@@ -27,18 +28,26 @@ TEST_DATA = os.path.join(ROOT, "tests", "data")
 # ==== Mitsuba set-up ====
 
 LLVM_CANDIDATES = ["/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so",
-                   "/usr/lib/x86_64-linux-gnu/libLLVM-15.so", "/usr/lib/x86_64-linux-gnu/libLLVM-14.so"]
+                   "/usr/lib/x86_64-linux-gnu/libLLVM-18.so", "/usr/lib/x86_64-linux-gnu/libLLVM-17.so",
+                   "/usr/lib/x86_64-linux-gnu/libLLVM-16.so", "/usr/lib/x86_64-linux-gnu/libLLVM-15.so",
+                   "/usr/lib/x86_64-linux-gnu/libLLVM-14.so"]
+
+
+def point_drjit_at_llvm():
+    """Set DRJIT_LIBLLVM_PATH to the first libLLVM found, unless it is set already."""
+    if "DRJIT_LIBLLVM_PATH" not in os.environ:
+        for cand in LLVM_CANDIDATES:
+            if os.path.exists(cand):
+                os.environ["DRJIT_LIBLLVM_PATH"] = cand
+                break
 
 
 def setup_mitsuba(variant="scalar_rgb"):
     """Import mitsuba and set `variant`; returns (mitsuba module, variant set). For an llvm variant
     DRJIT_LIBLLVM_PATH is pointed at the first libLLVM found (unless set); when the variant cannot
     be set (no LLVM) it falls back to scalar_rgb with a warning."""
-    if "llvm" in variant and "DRJIT_LIBLLVM_PATH" not in os.environ:
-        for cand in LLVM_CANDIDATES:
-            if os.path.exists(cand):
-                os.environ["DRJIT_LIBLLVM_PATH"] = cand
-                break
+    if "llvm" in variant:
+        point_drjit_at_llvm()
     import mitsuba as mi
     try:
         mi.set_variant(variant)
@@ -277,11 +286,6 @@ def sidak(alpha, n):
     return 1.0 - (1.0 - alpha) ** (1.0 / max(n, 1))
 
 
-def rel_mse(a, ref, eps=1e-2):
-    """Relative mean squared error mean((a - ref)^2 / (ref^2 + eps)) (eps keeps black pixels finite)."""
-    return float(np.mean((a - ref) ** 2 / (ref * ref + eps)))
-
-
 # ==== Mitsuba values for the tests (JSON files in tests/data/) ====
 
 def rounded(x, digits):
@@ -382,91 +386,10 @@ def write_ply_binary(path, verts, faces, normals, comment):
 # EXR reading): snee's EXR output, relative errors, Sidak thresholds, bootstrap intervals,
 # Mitsuba 3 set-up, and feature detection of the snee binary.
 
-import json  # noqa: E402
-import os  # noqa: E402
-import struct  # noqa: E402
-import subprocess  # noqa: E402
-import zlib  # noqa: E402
-
-# libLLVM candidates for Mitsuba's llvm_ad_rgb (Debian's libllvm19 first).
-MI_LLVM_CANDIDATES = ["/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1", "/usr/lib/x86_64-linux-gnu/libLLVM-19.so",
-                      "/usr/lib/x86_64-linux-gnu/libLLVM-18.so", "/usr/lib/x86_64-linux-gnu/libLLVM-17.so",
-                      "/usr/lib/x86_64-linux-gnu/libLLVM-16.so", "/usr/lib/x86_64-linux-gnu/libLLVM-15.so",
-                      "/usr/lib/x86_64-linux-gnu/libLLVM-14.so"]
-
-
-def read_exr(path):
-    """Minimal OpenEXR reader (numpy + zlib) for snee's output, so that the snee part needs no
-    `mitsuba` package: single part, scan lines or one-level tiles, compression none / ZIPS / ZIP,
-    half or float channels. Returns {channel name: (H, W) float32 array}."""
-    with open(path, "rb") as fh:
-        buf = fh.read()
-    magic, version = struct.unpack_from("<ii", buf, 0)
-    if magic != 20000630 or version & 0x1800:
-        raise ValueError(f"{path}: not a single-part, flat OpenEXR file")
-    tiled = bool(version & 0x200)
-    pos, attrs = 8, {}
-    while buf[pos] != 0:  # header: name\0 type\0 size value, until an empty name
-        end = buf.index(b"\0", pos)
-        end2 = buf.index(b"\0", end + 1)
-        (size,) = struct.unpack_from("<i", buf, end2 + 1)
-        attrs[buf[pos:end].decode()] = buf[end2 + 5:end2 + 5 + size]
-        pos = end2 + 5 + size
-    pos += 1
-    channels, cpos, chlist = [], 0, attrs["channels"]
-    while chlist[cpos] != 0:  # name\0 pixel_type pLinear reserved[3] xSampling ySampling
-        end = chlist.index(b"\0", cpos)
-        (ptype,) = struct.unpack_from("<i", chlist, end + 1)
-        sampling = struct.unpack_from("<ii", chlist, end + 9)
-        if sampling != (1, 1) or ptype not in (1, 2):
-            raise ValueError(f"{path}: subsampled or integer channels are not supported")
-        channels.append((chlist[cpos:end].decode(), np.dtype(np.float16 if ptype == 1 else np.float32)))
-        cpos = end + 17
-    comp = attrs["compression"][0]
-    if comp not in (0, 2, 3):
-        raise ValueError(f"{path}: compression {comp} is not supported (only none, ZIPS, ZIP)")
-    x0, y0, x1, y1 = struct.unpack("<iiii", attrs["dataWindow"])
-    width, height = x1 - x0 + 1, y1 - y0 + 1
-    out = {name: np.zeros((height, width), np.float32) for name, _ in channels}
-    if tiled:
-        tw, th, tmode = struct.unpack("<IIB", attrs["tiles"])
-        if tmode & 0xF:
-            raise ValueError(f"{path}: mip- or rip-mapped tiles are not supported")
-        nchunks = -(-width // tw) * -(-height // th)
-    else:
-        lines = 16 if comp == 3 else 1
-        nchunks = -(-height // lines)
-    for off in struct.unpack_from(f"<{nchunks}Q", buf, pos):
-        if tiled:
-            tx, ty, _, _, size = struct.unpack_from("<iiiii", buf, off)
-            data = buf[off + 20:off + 20 + size]
-            bx, by = tx * tw, ty * th
-            w, h = min(tw, width - bx), min(th, height - by)
-        else:
-            y, size = struct.unpack_from("<ii", buf, off)
-            data = buf[off + 8:off + 8 + size]
-            bx, by = 0, y - y0
-            w, h = width, min(lines, height - by)
-        raw_size = w * h * sum(t.itemsize for _, t in channels)
-        if comp != 0 and size < raw_size:  # zlib, then undo the predictor and the byte interleaving
-            t = np.frombuffer(zlib.decompress(data), np.uint8).astype(np.int64)
-            t[1:] -= 128
-            t = (np.cumsum(t) & 0xFF).astype(np.uint8)
-            half = (len(t) + 1) // 2
-            data = np.empty_like(t)
-            data[0::2], data[1::2] = t[:half], t[half:]
-            data = data.tobytes()
-        p = 0
-        for row in range(h):  # each scan line: every channel's w values, channels in header order
-            for name, typ in channels:
-                out[name][by + row, bx:bx + w] = np.frombuffer(data, typ, w, p)
-                p += w * typ.itemsize
-    return out
-
 
 def rgb_of(channels, prefix=""):
-    """(H, W, 3) float64 image of channels PREFIX R, G, B (e.g. prefix "m2." or "single.")."""
-    return np.stack([channels[prefix + c] for c in ("R", "G", "B")], axis=-1).astype(np.float64)
+    """rgb() as float64 (e.g. prefix "m2." or "single.")."""
+    return rgb(channels, prefix).astype(np.float64)
 
 
 def rel_mse(a, ref, denom):
@@ -477,8 +400,7 @@ def rel_mse(a, ref, denom):
 def sidak_z(alpha, m):
     """Two-sided |z| threshold at family-wise level alpha over m independent tests (Sidak)."""
     from scipy.stats import norm
-    per_test = 1.0 - (1.0 - alpha) ** (1.0 / max(m, 1))
-    return float(norm.isf(per_test / 2.0))
+    return float(norm.isf(sidak(alpha, m) / 2.0))
 
 
 def bootstrap_ci(stat, n, b=2000, level=0.95, seed=1):
@@ -500,11 +422,7 @@ def mitsuba_setup(variant="auto"):
     """Import Mitsuba 3 and set a variant: llvm_ad_rgb if libLLVM loads (DRJIT_LIBLLVM_PATH or a
     standard path), else scalar_rgb. Returns (mi, dr, variant, notes); raises ImportError when the
     package is missing and RuntimeError when no variant works."""
-    if "DRJIT_LIBLLVM_PATH" not in os.environ:
-        for cand in MI_LLVM_CANDIDATES:
-            if os.path.exists(cand):
-                os.environ["DRJIT_LIBLLVM_PATH"] = cand
-                break
+    point_drjit_at_llvm()
     import drjit as dr
     import mitsuba as mi
     notes = []
