@@ -28,10 +28,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import common  # noqa: E402
 
-if hasattr(common, "read_exr"):
-    read_exr = common.read_exr
-else:  # until the shared EXR reader lands in common.py
-    from reproduce_figures import read_exr  # noqa: E402
+read_exr = common.read_exr
 
 CLASSES = ["surface", "single", "snee_support", "snee_hidden", "surface_before_last", "internal_reflection", "other"]
 CONFIGS = ["sphere_smooth_st34", "sphere_ggx004_st34", "directional_ggx004_st34", "sphere_smooth_st02"]
