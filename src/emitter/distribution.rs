@@ -81,11 +81,8 @@ impl Distribution1D {
         let frac = (x - slot as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
         let (keep, alias) = self.table[slot];
         // A zero-probability bin keeps nothing (keep = 0), so it is never returned.
-        let (i, rescaled) = if frac < keep {
-            (slot, frac / keep)
-        } else {
-            (alias as usize, (frac - keep) / (1.0 - keep))
-        };
+        let (i, rescaled) =
+            if frac < keep { (slot, frac / keep) } else { (alias as usize, (frac - keep) / (1.0 - keep)) };
         Some((i, rescaled.clamp(0.0, 1.0 - f32::EPSILON / 2.0), self.pmf[i]))
     }
 }

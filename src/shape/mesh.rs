@@ -6,8 +6,8 @@
 
 use super::mesh_data::MeshData;
 use super::{obj, ply, serialized, Geometry};
-use crate::interaction::{PositionSample, SurfaceInteraction};
 use crate::emitter::distribution::Distribution1D;
+use crate::interaction::{PositionSample, SurfaceInteraction};
 use crate::math::{warp, Aabb, Frame, Mat4, Vec2, Vec3};
 use crate::scene::desc::ObjectDesc;
 use crate::scene::resolver::FileResolver;

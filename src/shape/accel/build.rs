@@ -200,18 +200,19 @@ fn best_split(bins: &Bins, binning: &Binning) -> Option<(usize, usize)> {
         (0..3).find(|&axis| binning.scale[axis] != 0.0).and_then(|axis| {
             let total: u32 = bins[axis].iter().map(|b| b.count).sum();
             let mut n = 0;
-            (1..nb).find(|&i| {
-                n += bins[axis][i - 1].count;
-                n > 0 && n < total && 2 * n >= total
-            })
-            .or_else(|| {
-                let mut n = 0;
-                (1..nb).find(|&i| {
+            (1..nb)
+                .find(|&i| {
                     n += bins[axis][i - 1].count;
-                    n > 0 && n < total
+                    n > 0 && n < total && 2 * n >= total
                 })
-            })
-            .map(|i| (axis, i))
+                .or_else(|| {
+                    let mut n = 0;
+                    (1..nb).find(|&i| {
+                        n += bins[axis][i - 1].count;
+                        n > 0 && n < total
+                    })
+                })
+                .map(|i| (axis, i))
         })
     })
 }
