@@ -1,6 +1,6 @@
-//! Ray-tracing acceleration: an 8-wide BVH over every triangle of the scene ([`bvh8`]), traversed
-//! nearest first with an AVX node test when the CPU has AVX2 (run-time detection; SSE otherwise)
-//! ([`traverse`]), with leaves of four triangles tested at once by the watertight test of Woop,
+//! Ray-tracing acceleration: an 8-wide BVH over every triangle of the scene ([`bvh8`], built by a
+//! parallel binned-SAH builder, [`build`]), traversed nearest first with an AVX node test when the
+//! CPU has AVX2 (run-time detection; SSE otherwise) ([`traverse`]), with leaves of four triangles tested at once by the watertight test of Woop,
 //! Benthin & Wald 2013 ([`triangle`]). Analytic shapes (spheres, disks) stay out of the BVH and are
 //! tested directly before it, in `f32`; scenes are expected to hold few of them.
 //!
