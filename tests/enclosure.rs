@@ -1,9 +1,11 @@
 //! The medium emitter-sampling skip (`integrator/enclosure.rs`): which media of the repository's
 //! scenes qualify, and that where one does, the full shadow-ray estimate is exactly 0 and consumes
-//! exactly the samples the skip draws (so skipping keeps the random-number stream).
+//! exactly the samples the skip draws (so skipping keeps the random-number stream), for `volpath`'s
+//! and for `volpathmis`'s shadow-ray estimate.
 
 use snee::integrator::stats::LocalStats;
 use snee::integrator::volpath::{sample_emitter, skip_sample_emitter};
+use snee::integrator::volpathmis::{sample_emitter as mis_sample_emitter, POverF};
 use snee::integrator::walk::RefPoint;
 use snee::math::Vec3;
 use snee::sampler::Sampler;
@@ -68,9 +70,18 @@ fn skip_draws_what_the_shadow_ray_draws() {
             } else {
                 nonzero += 1;
             }
+            // volpathmis's estimator (its own shadow-ray walk) from the same sample stream.
+            let mut mis = Sampler::new(5, i);
+            let (nee, uni, emitted_mis, _) =
+                mis_sample_emitter(&scene, RefPoint::Medium(p), Some(0), &POverF::ONE, channel, &mut mis, &mut stats);
             if scene.emitters_unreachable[0] {
                 assert_eq!(emitted, snee::color::Spectrum::ZERO, "{f}: nonzero estimate at {p}");
                 assert_eq!(full.next_1d(), skip.next_1d(), "{f}: sample streams diverge at {p}");
+                let c = nee.weight_with(&uni) * emitted_mis;
+                assert_eq!(c, snee::color::Spectrum::ZERO, "{f}: nonzero volpathmis estimate at {p}");
+                let mut skip = Sampler::new(5, i);
+                skip_sample_emitter(&scene, p, &mut skip);
+                assert_eq!(mis.next_1d(), skip.next_1d(), "{f}: volpathmis sample streams diverge at {p}");
             }
         }
         // The thin-dielectric sphere does not qualify, and there the estimate is often nonzero.

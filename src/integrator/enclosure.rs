@@ -78,9 +78,71 @@ fn encloses_inside(s: &Shape) -> bool {
     }
 }
 
-/// The signed volume of `mesh` when it is closed (vertices welded by position; every edge used
-/// once in each direction, no degenerate triangle), else `None`.
+/// The signed volume of `mesh` when it is closed (every edge used once in each direction, no
+/// triangle with two corners at one position), else `None`. Closed by vertex index is checked
+/// first (linear time); only a mesh that is not is checked again with vertices welded by position.
 fn closed_signed_volume(mesh: &Mesh) -> Option<f64> {
+    let degenerate = mesh.indices.iter().any(|t| {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize].to_array().map(f32::to_bits));
+        a == b || b == c || c == a
+    });
+    if degenerate {
+        return None;
+    }
+    if !closed_by_index(&mesh.indices, mesh.positions.len()) && !closed_welded(mesh) {
+        return None;
+    }
+    let volume = mesh
+        .indices
+        .iter()
+        .map(|tri| {
+            let [p0, p1, p2] = tri.map(|i| mesh.positions[i as usize].as_dvec3());
+            p0.dot(p1.cross(p2)) / 6.0
+        })
+        .sum();
+    Some(volume)
+}
+
+/// Is every edge of `indices` used exactly once in each direction? Directed edges are bucketed by
+/// their smaller vertex (a counting sort), then each small bucket is sorted and paired.
+fn closed_by_index(indices: &[[u32; 3]], vertex_count: usize) -> bool {
+    if indices.is_empty() {
+        return false;
+    }
+    let edge = |t: &[u32; 3], k: usize| (t[k], t[(k + 1) % 3]);
+    let mut start = vec![0u32; vertex_count + 1];
+    for t in indices {
+        for k in 0..3 {
+            let (a, b) = edge(t, k);
+            if a == b {
+                return false;
+            }
+            start[a.min(b) as usize + 1] += 1;
+        }
+    }
+    for v in 0..vertex_count {
+        start[v + 1] += start[v];
+    }
+    // Per bucket: the larger vertex · 2 + direction bit.
+    let mut fill = start.clone();
+    let mut other = vec![0u64; 3 * indices.len()];
+    for t in indices {
+        for k in 0..3 {
+            let (a, b) = edge(t, k);
+            let slot = &mut fill[a.min(b) as usize];
+            other[*slot as usize] = ((a.max(b) as u64) << 1) | (a < b) as u64;
+            *slot += 1;
+        }
+    }
+    start.windows(2).all(|w| {
+        let bucket = &mut other[w[0] as usize..w[1] as usize];
+        bucket.sort_unstable();
+        bucket.chunks(2).all(|c| c.len() == 2 && c[0] >> 1 == c[1] >> 1 && c[0] & 1 == 0 && c[1] & 1 == 1)
+    })
+}
+
+/// Closedness with vertices welded by position (for meshes that split vertices at seams).
+fn closed_welded(mesh: &Mesh) -> bool {
     let mut weld: HashMap<[u32; 3], u32> = HashMap::with_capacity(mesh.positions.len());
     let ids: Vec<u32> = mesh
         .positions
@@ -90,25 +152,8 @@ fn closed_signed_volume(mesh: &Mesh) -> Option<f64> {
             *weld.entry(p.to_array().map(f32::to_bits)).or_insert(n)
         })
         .collect();
-    // Undirected edge key · 2 + direction bit: a closed, consistently oriented mesh has each key
-    // exactly twice, once per direction.
-    let mut edges: Vec<u64> = Vec::with_capacity(mesh.indices.len() * 3);
-    let mut volume = 0.0f64;
-    for tri in &mesh.indices {
-        let v = tri.map(|i| ids[i as usize]);
-        if v[0] == v[1] || v[1] == v[2] || v[2] == v[0] {
-            return None;
-        }
-        for k in 0..3 {
-            let (a, b) = (v[k] as u64, v[(k + 1) % 3] as u64);
-            edges.push((a.min(b) << 33) | (a.max(b) << 1) | (a < b) as u64);
-        }
-        let [p0, p1, p2] = tri.map(|i| mesh.positions[i as usize].as_dvec3());
-        volume += p0.dot(p1.cross(p2)) / 6.0;
-    }
-    edges.sort_unstable();
-    let paired = edges.chunks(2).all(|c| c.len() == 2 && c[0] >> 1 == c[1] >> 1 && c[0] & 1 == 0 && c[1] & 1 == 1);
-    (paired && !edges.is_empty()).then_some(volume)
+    let welded: Vec<[u32; 3]> = mesh.indices.iter().map(|tri| tri.map(|i| ids[i as usize])).collect();
+    closed_by_index(&welded, weld.len())
 }
 
 #[cfg(test)]
@@ -131,6 +176,20 @@ mod tests {
         let v = closed_signed_volume(&tetra(false)).unwrap();
         assert!((v - 1.0 / 6.0).abs() < 1e-9, "{v}");
         assert!(closed_signed_volume(&tetra(true)).unwrap() < 0.0);
+    }
+
+    /// A seam (a vertex duplicated at the same position) is closed after welding only.
+    #[test]
+    fn split_vertex_is_welded() {
+        let mut m = tetra(false);
+        m.positions.push(m.positions[3]);
+        m.indices[3][2] = 4;
+        assert!(!closed_by_index(&m.indices, m.positions.len()));
+        let v = closed_signed_volume(&m).unwrap();
+        assert!((v - 1.0 / 6.0).abs() < 1e-9, "{v}");
+        // A triangle with two corners at one position is degenerate.
+        m.indices[0] = [3, 4, 1];
+        assert!(closed_signed_volume(&m).is_none());
     }
 
     #[test]

@@ -279,7 +279,9 @@ impl PathWeight for SpectralMis {
         let (scene, channel, medium) = (cx.scene, cx.channel, cx.medium);
         let (sampler, stats) = (&mut *cx.sampler, &mut *cx.stats);
         let mut c = Spectrum::ZERO;
-        if m.sample_emitters {
+        if m.sample_emitters && medium.is_some_and(|mi| scene.emitters_unreachable[mi as usize]) {
+            super::volpath::skip_sample_emitter(scene, p, sampler); // always 0 here: integrator/enclosure.rs
+        } else if m.sample_emitters {
             let (mut nee_end, mut uni_end, emitted, ds) =
                 sample_emitter(scene, RefPoint::Medium(p), medium, &self.p_over_f, channel, sampler, stats);
             let phase_val = m.phase.eval(wi, ds.d);

@@ -13,6 +13,7 @@
 
 use super::mesh_data::MeshData;
 use super::{obj, ply, serialized, Geometry};
+use crate::emitter::distribution::Distribution1D;
 use crate::interaction::{shading_frame, PositionSample, SurfaceInteraction};
 use crate::math::{warp, Aabb, Frame, Mat4, Vec2, Vec3};
 use crate::scene::desc::ObjectDesc;
@@ -33,8 +34,8 @@ pub struct Mesh {
     /// dp/du of each triangle's uv parametrisation (zero where the uv triangle is degenerate);
     /// empty when the mesh has no uvs (then dp/du = p1 − p0 of the barycentric uv).
     pub face_dp_du: Vec<Vec3>,
-    /// Cumulative triangle areas (for area sampling); last entry = total area.
-    area_cdf: Vec<f32>,
+    /// Triangles by area (alias table, for area sampling).
+    area_distr: Distribution1D,
 }
 
 impl Mesh {
@@ -70,13 +71,15 @@ impl Mesh {
                 })
                 .collect()
         };
-        let mut area_cdf = Vec::with_capacity(data.indices.len());
-        let mut total = 0.0f64;
-        for idx in &data.indices {
-            let [a, b, c] = idx.map(|i| positions[i as usize]);
-            total += 0.5 * (b - a).cross(c - a).length() as f64;
-            area_cdf.push(total as f32);
-        }
+        let areas: Vec<f32> = data
+            .indices
+            .iter()
+            .map(|idx| {
+                let [a, b, c] = idx.map(|i| positions[i as usize]);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .collect();
+        let area_distr = Distribution1D::new(&areas);
         Mesh {
             positions,
             normals,
@@ -85,12 +88,12 @@ impl Mesh {
             flip_normals,
             face_normals: face_n,
             face_dp_du,
-            area_cdf,
+            area_distr,
         }
     }
 
     pub fn surface_area(&self) -> f32 {
-        self.area_cdf.last().copied().unwrap_or(0.0)
+        self.area_distr.sum() as f32
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -166,11 +169,8 @@ impl Mesh {
     /// Uniform by area: pick a triangle by area, then a uniform point on it.
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
         let total = self.surface_area();
-        let target = sample.x * total;
-        let prim = self.area_cdf.partition_point(|&c| c <= target).min(self.indices.len().saturating_sub(1));
-        let lo = if prim == 0 { 0.0 } else { self.area_cdf[prim - 1] };
-        let area = self.area_cdf[prim] - lo;
-        let sx = if area > 0.0 { ((target - lo) / area).clamp(0.0, 1.0 - f32::EPSILON) } else { 0.5 };
+        // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf, as before).
+        let (prim, sx, _) = self.area_distr.sample(sample.x).unwrap_or((0, 0.5, 0.0));
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
         let (p, n, uv) = self.point(prim as u32, b.x, b.y);
         PositionSample { p, n, uv, pdf: 1.0 / total }

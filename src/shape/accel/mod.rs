@@ -1,6 +1,6 @@
-//! Ray-tracing acceleration: an 8-wide BVH over every triangle of the scene ([`bvh8`]), traversed
-//! nearest first with an AVX node test when the CPU has AVX2 (run-time detection; SSE otherwise)
-//! ([`traverse`]), with leaves of four triangles tested at once by the watertight test of Woop,
+//! Ray-tracing acceleration: an 8-wide BVH over every triangle of the scene ([`bvh8`], built by a
+//! parallel binned-SAH builder, [`build`]), traversed nearest first with an AVX node test when the
+//! CPU has AVX2 (run-time detection; SSE otherwise) ([`traverse`]), with leaves of four triangles tested at once by the watertight test of Woop,
 //! Benthin & Wald 2013 ([`triangle`]). Analytic shapes (spheres, disks) stay out of the BVH and are
 //! tested directly before it, in `f32`; scenes are expected to hold few of them.
 //!
@@ -8,16 +8,17 @@
 //! triangle test is watertight, so no ray slips through a shared edge or vertex of a closed mesh
 //! (`tests/accel.rs` checks 1.4 M rays through a closed 1.3 M-triangle sphere).
 
+pub mod build;
 pub mod bvh8;
 pub mod traverse;
 pub mod triangle;
 
 use super::{Geometry, Shape};
 use crate::math::Ray;
+use build::Bounds;
 use bvh8::Bvh8;
 use glam::Vec3A;
-use obvhs::aabb::Aabb as BvhAabb;
-use obvhs::BvhBuildParams;
+use rayon::prelude::*;
 use std::mem::MaybeUninit;
 use traverse::{Stack, STACK};
 
@@ -73,12 +74,12 @@ pub struct Accel {
 
 impl Accel {
     pub fn build(shapes: &[Shape]) -> Accel {
-        Self::build_with(shapes, BvhBuildParams::medium_build(), Isa::detect())
+        Self::build_with(shapes, Isa::detect())
     }
 
-    /// Build with the given obvhs preset and node-test ISA (`isa` must be supported by the CPU:
-    /// use `Isa::detect()` or `Isa::Portable`).
-    pub fn build_with(shapes: &[Shape], params: BvhBuildParams, isa: Isa) -> Accel {
+    /// Build with the given node-test ISA (`Isa::Avx2` falls back to `Isa::Portable` when the CPU
+    /// lacks it).
+    pub fn build_with(shapes: &[Shape], isa: Isa) -> Accel {
         let isa = if isa == Isa::Avx2 && Isa::detect() != Isa::Avx2 { Isa::Portable } else { isa };
         let mut prims = Vec::new();
         let mut bounds = Vec::new();
@@ -87,28 +88,25 @@ impl Accel {
         for (si, s) in shapes.iter().enumerate() {
             match &s.geometry {
                 Geometry::Mesh(m) => {
-                    prims.reserve(m.indices.len());
-                    bounds.reserve(m.indices.len());
-                    tris.reserve(m.indices.len());
-                    for (pi, idx) in m.indices.iter().enumerate() {
-                        let v = idx.map(|i| m.positions[i as usize]);
-                        let va = v.map(Vec3A::from);
-                        let mut b = BvhAabb { min: va[0].min(va[1]).min(va[2]), max: va[0].max(va[1]).max(va[2]) };
+                    prims.extend((0..m.indices.len() as u32).map(|pi| PrimRef { shape: si as u32, prim: pi }));
+                    let vertices = |idx: &[u32; 3]| idx.map(|i| m.positions[i as usize]);
+                    tris.par_extend(m.indices.par_iter().map(vertices));
+                    bounds.par_extend(m.indices.par_iter().map(|idx| {
+                        let va = vertices(idx).map(Vec3A::from);
+                        let mut b = Bounds { min: va[0].min(va[1]).min(va[2]), max: va[0].max(va[1]).max(va[2]) };
                         // Pad the box by a little more than the rounding of the node test, so a
                         // ray through a box corner (a vertex shared by triangles) is never culled.
                         let pad =
                             (b.max - b.min).max_element() * 1e-4 + b.min.abs().max(b.max.abs()).max_element() * 1e-6;
                         b.min -= Vec3A::splat(pad);
                         b.max += Vec3A::splat(pad);
-                        prims.push(PrimRef { shape: si as u32, prim: pi as u32 });
-                        bounds.push(b);
-                        tris.push(v);
-                    }
+                        b
+                    }));
                 }
                 _ => analytic.push(si as u32),
             }
         }
-        let bvh = Bvh8::build(&tris, &bounds, &params);
+        let bvh = build::build(&tris, bounds);
         Accel { bvh, prims, analytic, isa }
     }
 

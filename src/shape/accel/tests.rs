@@ -88,7 +88,7 @@ fn traversal_equals_brute_force() {
     for (seed, count, spread) in [(1, 2000, 10.0), (2, 500, 40.0), (3, 3, 1.0), (4, 40, 3.0)] {
         let shapes = soup(seed, count, spread);
         for isa in [Isa::Portable, Isa::detect()] {
-            let accel = Accel::build_with(&shapes, BvhBuildParams::medium_build(), isa);
+            let accel = Accel::build_with(&shapes, isa);
             let mut s = Sampler::new(seed + 100, 0);
             let mut hits = 0;
             for i in 0..3000 {

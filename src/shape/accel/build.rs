@@ -1,0 +1,507 @@
+//! Binned SAH builder of the 8-wide BVH (Wald 2007, "On fast Construction of SAH-based Bounding
+//! Volume Hierarchies"), built eight-wide directly: a node starts with one cluster of primitives
+//! and splits the cluster of largest surface area until it has eight (as Embree's builders do,
+//! Wald et al. 2014), each split chosen by the surface area heuristic over 32 bins of the
+//! centroids on every axis (as many bins as triangles in smaller clusters). A cluster of at most
+//! `LEAF_SIZE` triangles becomes one leaf packet.
+//!
+//! The cost of a side is its area times its triangle count (counting leaf packets, ⌈n / 4⌉,
+//! instead made fuller leaves but slower traversal on the statue and the Cornell box). A cluster
+//! whose centroids all coincide is halved by index.
+//!
+//! Parallel (rayon): large clusters are binned in chunks on every thread, and the subtrees below a
+//! large node are built concurrently, each into its own arrays, which are then appended to the
+//! parent's with their indices shifted. The result does not depend on the thread count.
+//!
+//! Node and leaf boxes are exact unions of the (padded) primitive boxes: they come from the
+//! partition pass itself, not from the bins.
+
+use super::bvh8::{Bvh8, Node8, EMPTY, LEAF, LEAF_SIZE};
+use super::triangle::TriPacket4;
+use crate::math::Vec3;
+use glam::Vec3A;
+use rayon::prelude::*;
+
+/// Bins per axis (at most; a cluster of `n` triangles uses `n` of them).
+const BINS: usize = 32;
+/// Clusters at least this large are binned in parallel chunks of this size.
+const PARALLEL_BIN: usize = 1 << 15;
+/// Nodes over at least this many triangles build their subtrees in parallel.
+const PARALLEL_NODE: usize = 1 << 12;
+
+/// An axis-aligned box (also used for boxes of centroids, stored doubled: `min + max`).
+#[derive(Clone, Copy, Debug)]
+pub struct Bounds {
+    pub min: Vec3A,
+    pub max: Vec3A,
+}
+
+impl Bounds {
+    pub const EMPTY: Bounds = Bounds { min: Vec3A::splat(f32::INFINITY), max: Vec3A::splat(f32::NEG_INFINITY) };
+
+    #[inline(always)]
+    fn grow(&mut self, b: &Bounds) {
+        self.min = self.min.min(b.min);
+        self.max = self.max.max(b.max);
+    }
+
+    #[inline(always)]
+    fn grow_point(&mut self, p: Vec3A) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    #[inline(always)]
+    fn union(mut self, b: &Bounds) -> Bounds {
+        self.grow(b);
+        self
+    }
+
+    /// Half the surface area (0 for an empty box).
+    #[inline(always)]
+    fn half_area(&self) -> f32 {
+        let e = (self.max - self.min).max(Vec3A::ZERO);
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+
+    /// Twice the centre (the centroid key the bins use).
+    #[inline(always)]
+    fn centroid2(&self) -> Vec3A {
+        self.min + self.max
+    }
+}
+
+/// Primitives `start..end` of the current slice, their box and the box of their doubled centroids.
+#[derive(Clone, Copy, Debug)]
+struct Cluster {
+    start: usize,
+    end: usize,
+    bounds: Bounds,
+    centroids: Bounds,
+}
+
+impl Cluster {
+    fn len(&self) -> usize {
+        self.end - self.start
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    bounds: Bounds,
+    count: u32,
+}
+
+type Bins = [[Bin; BINS]; 3];
+
+const EMPTY_BINS: Bins = [[Bin { bounds: Bounds::EMPTY, count: 0 }; BINS]; 3];
+
+/// The bin mapping of a cluster: bin of a doubled centroid `c` on each axis.
+#[derive(Clone, Copy)]
+struct Binning {
+    origin: Vec3A,
+    scale: Vec3A,
+    /// Bins in use.
+    count: usize,
+}
+
+impl Binning {
+    fn new(centroids: &Bounds, n: usize) -> Binning {
+        let count = n.clamp(4, BINS);
+        let extent = centroids.max - centroids.min;
+        // Slightly under count / extent so that the largest centroid lands in the last bin; an
+        // axis without extent (or with an infinite one) maps everything to bin 0.
+        let scale = Vec3A::select(
+            extent.cmpgt(Vec3A::ZERO) & extent.cmplt(Vec3A::INFINITY),
+            Vec3A::splat(count as f32 * 0.999_99) / extent,
+            Vec3A::ZERO,
+        );
+        Binning { origin: centroids.min, scale, count }
+    }
+
+    /// Bins of doubled centroid `c` on the three axes (clamped; NaN maps to bin 0). Binning and
+    /// partition both use it, so they agree bit for bit.
+    #[inline(always)]
+    fn bins(&self, c: Vec3A) -> [usize; 3] {
+        // max(x, 0) returns 0 for a NaN x (glam's `max` keeps the second operand then).
+        let x = ((c - self.origin) * self.scale).max(Vec3A::ZERO).min(Vec3A::splat((self.count - 1) as f32));
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::*;
+            let mut k = [0i32; 4];
+            // SAFETY: SSE2 is part of x86-64; the lanes are in [0, count − 1], so the truncation
+            // is exact and `k` holds small non-negative integers.
+            unsafe { _mm_storeu_si128(k.as_mut_ptr().cast(), _mm_cvttps_epi32(x.into())) };
+            [k[0] as usize & (BINS - 1), k[1] as usize & (BINS - 1), k[2] as usize & (BINS - 1)]
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            x.to_array().map(|v| (v as usize) & (BINS - 1))
+        }
+    }
+}
+
+fn bin_slice(bins: &mut Bins, prims: &[Bounds], binning: &Binning) {
+    for p in prims {
+        let k = binning.bins(p.centroid2());
+        for (axis, bins) in bins.iter_mut().enumerate() {
+            let b = &mut bins[k[axis]];
+            b.bounds.grow(p);
+            b.count += 1;
+        }
+    }
+}
+
+fn merge_bins(mut a: Bins, b: Bins) -> Bins {
+    for axis in 0..3 {
+        for i in 0..BINS {
+            a[axis][i].bounds.grow(&b[axis][i].bounds);
+            a[axis][i].count += b[axis][i].count;
+        }
+    }
+    a
+}
+
+/// The cheapest split of the binned cluster: (axis, first bin of the right side), or None when
+/// no plane separates the centroids.
+fn best_split(bins: &Bins, binning: &Binning) -> Option<(usize, usize)> {
+    let mut best: Option<(usize, usize)> = None;
+    let mut best_cost = f32::INFINITY;
+    let nb = binning.count;
+    for (axis, bins) in bins.iter().enumerate() {
+        if binning.scale[axis] == 0.0 {
+            continue;
+        }
+        // Right-to-left sweep: cost of the right side for a split before bin i.
+        let mut right_cost = [0.0f32; BINS];
+        let mut acc = Bounds::EMPTY;
+        let mut n = 0;
+        for i in (1..nb).rev() {
+            acc.grow(&bins[i].bounds);
+            n += bins[i].count;
+            right_cost[i] = if n > 0 { acc.half_area() * n as f32 } else { f32::NAN };
+        }
+        let mut acc = Bounds::EMPTY;
+        let mut n = 0;
+        for i in 1..nb {
+            acc.grow(&bins[i - 1].bounds);
+            n += bins[i - 1].count;
+            // NaN (an empty side) never compares below the best cost.
+            let cost = if n > 0 { acc.half_area() * n as f32 + right_cost[i] } else { f32::NAN };
+            if cost < best_cost {
+                best_cost = cost;
+                best = Some((axis, i));
+            }
+        }
+    }
+    // Infinite costs (overflowing areas) leave `best` empty when nothing is finite; then a split
+    // with both sides non-empty still exists on any axis with extent: take the middle of it.
+    best.or_else(|| {
+        (0..3).find(|&axis| binning.scale[axis] != 0.0).and_then(|axis| {
+            let total: u32 = bins[axis].iter().map(|b| b.count).sum();
+            let mut n = 0;
+            (1..nb)
+                .find(|&i| {
+                    n += bins[axis][i - 1].count;
+                    n > 0 && n < total && 2 * n >= total
+                })
+                .or_else(|| {
+                    let mut n = 0;
+                    (1..nb).find(|&i| {
+                        n += bins[axis][i - 1].count;
+                        n > 0 && n < total
+                    })
+                })
+                .map(|i| (axis, i))
+        })
+    })
+}
+
+/// Split cluster `c` of `prims` / `ids` into two non-empty clusters (`bins`: scratch space).
+fn split(prims: &mut [Bounds], ids: &mut [u32], c: &Cluster, bins: &mut Bins) -> (Cluster, Cluster) {
+    debug_assert!(c.len() >= 2);
+    let (p, id) = (&mut prims[c.start..c.end], &mut ids[c.start..c.end]);
+    let binning = Binning::new(&c.centroids, p.len());
+    if p.len() >= 2 * PARALLEL_BIN {
+        *bins = p
+            .par_chunks(PARALLEL_BIN)
+            .map(|ch| {
+                let mut bins = EMPTY_BINS;
+                bin_slice(&mut bins, ch, &binning);
+                bins
+            })
+            .reduce(|| EMPTY_BINS, merge_bins);
+    } else {
+        for axis in bins.iter_mut() {
+            axis[..binning.count].fill(Bin { bounds: Bounds::EMPTY, count: 0 });
+        }
+        bin_slice(bins, p, &binning);
+    }
+    let (mut lb, mut lc, mut rb, mut rc) = (Bounds::EMPTY, Bounds::EMPTY, Bounds::EMPTY, Bounds::EMPTY);
+    let mid = match best_split(bins, &binning) {
+        Some((axis, first_right)) => {
+            let (mut i, mut j) = (0, p.len());
+            while i < j {
+                let b = p[i];
+                let cen = b.centroid2();
+                if binning.bins(cen)[axis] < first_right {
+                    lb.grow(&b);
+                    lc.grow_point(cen);
+                    i += 1;
+                } else {
+                    rb.grow(&b);
+                    rc.grow_point(cen);
+                    j -= 1;
+                    p.swap(i, j);
+                    id.swap(i, j);
+                }
+            }
+            i
+        }
+        None => 0,
+    };
+    // No separating plane (all centroids equal, or a partition that came out one-sided): halve.
+    let mid = if mid == 0 || mid == p.len() {
+        let mid = p.len() / 2;
+        (lb, lc, rb, rc) = (Bounds::EMPTY, Bounds::EMPTY, Bounds::EMPTY, Bounds::EMPTY);
+        for b in &p[..mid] {
+            lb.grow(b);
+            lc.grow_point(b.centroid2());
+        }
+        for b in &p[mid..] {
+            rb.grow(b);
+            rc.grow_point(b.centroid2());
+        }
+        mid
+    } else {
+        mid
+    };
+    let m = c.start + mid;
+    (
+        Cluster { start: c.start, end: m, bounds: lb, centroids: lc },
+        Cluster { start: m, end: c.end, bounds: rb, centroids: rc },
+    )
+}
+
+/// Box and centroid box of `prims` (in parallel when large).
+fn cluster_of(prims: &[Bounds]) -> Cluster {
+    let one = |ch: &[Bounds]| {
+        let (mut b, mut c) = (Bounds::EMPTY, Bounds::EMPTY);
+        for p in ch {
+            b.grow(p);
+            c.grow_point(p.centroid2());
+        }
+        (b, c)
+    };
+    let (bounds, centroids) = if prims.len() >= 2 * PARALLEL_BIN {
+        prims
+            .par_chunks(PARALLEL_BIN)
+            .map(one)
+            .reduce(|| (Bounds::EMPTY, Bounds::EMPTY), |a, b| (a.0.union(&b.0), a.1.union(&b.1)))
+    } else {
+        one(prims)
+    };
+    Cluster { start: 0, end: prims.len(), bounds, centroids }
+}
+
+/// Nodes, packets and lane indices of a (sub)tree; child references are local to it.
+struct Part {
+    nodes: Vec<Node8>,
+    packets: Vec<TriPacket4>,
+    lane_prims: Vec<u32>,
+    depth: usize,
+    /// Scratch bins for the splits.
+    bins: Box<Bins>,
+}
+
+impl Part {
+    /// An empty part, with room for a subtree over `n` triangles.
+    fn new(n: usize) -> Part {
+        Part {
+            nodes: Vec::with_capacity(n / 12 + 1),
+            packets: Vec::with_capacity(n / 3 + 1),
+            lane_prims: Vec::with_capacity(4 * (n / 3 + 1)),
+            depth: 0,
+            bins: Box::new(EMPTY_BINS),
+        }
+    }
+
+    fn leaf(&mut self, tris: &[[Vec3; 3]], ids: &[u32]) -> u32 {
+        debug_assert!(!ids.is_empty() && ids.len() <= LEAF_SIZE);
+        let mut packet = TriPacket4::EMPTY;
+        let mut lanes = [u32::MAX; LEAF_SIZE];
+        for (lane, &id) in ids.iter().enumerate() {
+            packet.set(lane, tris[id as usize]);
+            lanes[lane] = id;
+        }
+        self.packets.push(packet);
+        self.lane_prims.extend_from_slice(&lanes);
+        LEAF | (self.packets.len() - 1) as u32
+    }
+
+    /// Append `sub` (root reference `root`), shifting its references; returns the shifted root.
+    fn append(&mut self, sub: Part, root: u32) -> u32 {
+        let (node_off, packet_off) = (self.nodes.len() as u32, self.packets.len() as u32);
+        let shift = |c: u32| {
+            if c == EMPTY {
+                c
+            } else if c & LEAF != 0 {
+                LEAF | ((c & !LEAF) + packet_off)
+            } else {
+                c + node_off
+            }
+        };
+        self.nodes.extend(sub.nodes.into_iter().map(|mut n| {
+            n.child = n.child.map(shift);
+            n
+        }));
+        self.packets.extend(sub.packets);
+        self.lane_prims.extend(sub.lane_prims);
+        self.depth = self.depth.max(sub.depth);
+        shift(root)
+    }
+}
+
+/// Up to eight clusters covering `c`: the one of largest area (with more than `LEAF_SIZE`
+/// triangles) is split until there are eight or none is left to split. Sorted by position.
+fn open(prims: &mut [Bounds], ids: &mut [u32], c: Cluster, bins: &mut Bins) -> ([Cluster; 8], usize) {
+    let mut kids = [c; 8];
+    // Half area of each kid, or −1 when it is too small to split.
+    let mut area = [-1.0f32; 8];
+    let splittable = |k: &Cluster| if k.len() > LEAF_SIZE { k.bounds.half_area() } else { -1.0 };
+    area[0] = splittable(&c);
+    let mut n = 1;
+    while n < 8 {
+        let i = (0..n).fold(0, |b, i| if area[i] > area[b] { i } else { b });
+        if area[i] < 0.0 {
+            break;
+        }
+        let (l, r) = split(prims, ids, &kids[i], bins);
+        (kids[i], kids[n]) = (l, r);
+        (area[i], area[n]) = (splittable(&l), splittable(&r));
+        n += 1;
+    }
+    kids[..n].sort_unstable_by_key(|k| k.start);
+    (kids, n)
+}
+
+/// Emit the subtree over cluster `c` (which covers all of `prims`) into `part`: its reference.
+fn emit(part: &mut Part, tris: &[[Vec3; 3]], prims: &mut [Bounds], ids: &mut [u32], c: Cluster, depth: usize) -> u32 {
+    if c.len() <= LEAF_SIZE {
+        return part.leaf(tris, &ids[c.start..c.end]);
+    }
+    part.depth = part.depth.max(depth);
+    let (kids, n) = open(prims, ids, c, &mut part.bins);
+    let kids = &kids[..n];
+    let index = part.nodes.len();
+    part.nodes.push(Node8::UNUSED);
+    let mut node = Node8::UNUSED;
+    for (slot, k) in kids.iter().enumerate() {
+        for axis in 0..3 {
+            node.bounds[2 * axis][slot] = k.bounds.min[axis];
+            node.bounds[2 * axis + 1][slot] = k.bounds.max[axis];
+        }
+    }
+    let rebase = |k: &Cluster| Cluster { start: 0, end: k.len(), ..*k };
+    if c.len() >= PARALLEL_NODE {
+        // Disjoint slices per child, built concurrently into their own parts.
+        let mut jobs = Vec::with_capacity(kids.len());
+        let (mut rest_p, mut rest_i) = (prims, ids);
+        for k in kids {
+            let (p, tail_p) = std::mem::take(&mut rest_p).split_at_mut(k.len());
+            let (i, tail_i) = std::mem::take(&mut rest_i).split_at_mut(k.len());
+            (rest_p, rest_i) = (tail_p, tail_i);
+            jobs.push((p, i, rebase(k)));
+        }
+        let subs: Vec<(Part, u32)> = jobs
+            .into_par_iter()
+            .map(|(p, i, k)| {
+                let mut sub = Part::new(k.len());
+                let root = emit(&mut sub, tris, p, i, k, depth + 1);
+                (sub, root)
+            })
+            .collect();
+        for (slot, (sub, root)) in subs.into_iter().enumerate() {
+            node.child[slot] = part.append(sub, root);
+        }
+    } else {
+        for (slot, k) in kids.iter().enumerate() {
+            node.child[slot] =
+                emit(part, tris, &mut prims[k.start..k.end], &mut ids[k.start..k.end], rebase(k), depth + 1);
+        }
+    }
+    part.nodes[index] = node;
+    index as u32
+}
+
+/// The BVH over triangles `tris` with boxes `bounds` (which may be padded). None when empty.
+pub fn build(tris: &[[Vec3; 3]], bounds: Vec<Bounds>) -> Option<Bvh8> {
+    if tris.is_empty() {
+        return None;
+    }
+    let mut prims = bounds;
+    let mut ids: Vec<u32> = (0..prims.len() as u32).collect();
+    let root_cluster = cluster_of(&prims);
+    let mut part = Part::new(prims.len());
+    // A whole scene of at most LEAF_SIZE triangles is one packet (depth 0); else node 0 is the root.
+    let root = emit(&mut part, tris, &mut prims, &mut ids, root_cluster, 1);
+    Some(Bvh8 { nodes: part.nodes, packets: part.packets, lane_prims: part.lane_prims, root, depth: part.depth })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn boxes(points: &[Vec3]) -> Vec<Bounds> {
+        points.iter().map(|&p| Bounds { min: Vec3A::from(p), max: Vec3A::from(p) + 0.1 }).collect()
+    }
+
+    /// Every triangle is in exactly one lane, every child box contains its subtree's boxes, and
+    /// the depth bound holds; also for coincident centroids and huge coordinates.
+    #[test]
+    fn tree_is_complete_and_boxes_contain_children() {
+        let mut s = crate::sampler::Sampler::new(5, 0);
+        let mut cases: Vec<Vec<Vec3>> = vec![
+            (0..20_000).map(|_| Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) * 10.0).collect(),
+            vec![Vec3::ONE; 1000],
+            (0..3).map(|i| Vec3::splat(i as f32)).collect(),
+            (0..500).map(|i| Vec3::new(if i % 2 == 0 { 1e18 } else { -1e18 }, i as f32, 0.0)).collect(),
+        ];
+        cases.push((0..9000).map(|i| Vec3::new((i % 7) as f32, 0.0, 0.0)).collect());
+        for pts in cases {
+            let tris: Vec<[Vec3; 3]> = pts.iter().map(|&p| [p, p + Vec3::X * 0.1, p + Vec3::Y * 0.1]).collect();
+            let b = boxes(&pts);
+            let bvh = build(&tris, b.clone()).unwrap();
+            let mut seen = vec![0u32; pts.len()];
+            // (reference, box it must lie in, depth)
+            let mut stack = vec![(bvh.root, Bounds { min: Vec3A::NEG_INFINITY, max: Vec3A::INFINITY }, 1)];
+            while let Some((r, outer, d)) = stack.pop() {
+                if r & LEAF != 0 {
+                    let p = (r & !LEAF) as usize;
+                    for &id in &bvh.lane_prims[4 * p..4 * p + 4] {
+                        if id != u32::MAX {
+                            seen[id as usize] += 1;
+                            let pb = b[id as usize];
+                            assert!(outer.min.cmple(pb.min).all() && pb.max.cmple(outer.max).all());
+                        }
+                    }
+                    continue;
+                }
+                assert!(d <= bvh.depth);
+                let n = &bvh.nodes[r as usize];
+                for slot in 0..8 {
+                    if n.child[slot] == EMPTY {
+                        continue;
+                    }
+                    let cb = Bounds {
+                        min: Vec3A::new(n.bounds[0][slot], n.bounds[2][slot], n.bounds[4][slot]),
+                        max: Vec3A::new(n.bounds[1][slot], n.bounds[3][slot], n.bounds[5][slot]),
+                    };
+                    assert!(outer.min.cmple(cb.min).all() && cb.max.cmple(outer.max).all());
+                    stack.push((n.child[slot], cb, d + 1));
+                }
+            }
+            assert!(seen.iter().all(|&k| k == 1), "a triangle is missing or repeated");
+        }
+    }
+}
