@@ -31,8 +31,8 @@ pub struct ManifoldStage<'a> {
     tracker: Tracker,
     /// The pending suffix as it was when the ray reached the current surface (or escaped).
     arrived: Option<Pending>,
-    /// Did the current ray escape the scene (an environment hit)?
-    escaped: bool,
+    /// The surface the current ray reached (`None`: it escaped, an environment hit).
+    hit: Option<SurfaceInteraction>,
 }
 
 impl<'a> ManifoldStage<'a> {
@@ -42,7 +42,7 @@ impl<'a> ManifoldStage<'a> {
             snee,
             tracker: Tracker::default(),
             arrived: None,
-            escaped: false,
+            hit: None,
         })
     }
 
@@ -74,7 +74,7 @@ impl<'a> ManifoldStage<'a> {
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.arrived = self.tracker.surface_event();
-        self.escaped = si.is_none();
+        self.hit = si.copied();
     }
 
     /// The weight of an emitter hit along `d` by forward tracing, when the manifold connection
@@ -89,7 +89,7 @@ impl<'a> ManifoldStage<'a> {
         stats: &mut LocalStats,
     ) -> Option<f32> {
         let opts = Some(self.snee.options);
-        forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.escaped, d, channel, stats)
+        forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.hit.as_ref(), d, channel, stats)
     }
 
     /// BSDF sampling at `s` chose `bs` towards `wo`.
