@@ -22,6 +22,7 @@
 //! ([`ManifoldStage`], `manifold/stage.rs`).
 
 use super::manifold::ManifoldStage;
+use super::snee::stage::Scatter;
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
 use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, PathSetup, RefPoint, MAX_SEGMENTS};
@@ -450,13 +451,13 @@ pub fn trace<W: PathWeight>(
 
                 // ---- Subdivision next-event estimation (volpath_snee) ----
                 if let Some(snee) = &mut snee {
-                    let beta = weight.beta();
-                    result += snee.at_scatter(scene, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+                    let v = Scatter { medium: mi, p, wi, depth, max_depth, beta: weight.beta() };
+                    let cx = &mut Cx { scene, channel, sampler, stats };
+                    result += snee.at_scatter(cx, &v);
 
                     // ---- Manifold next-event estimation (connection = complete) ----
                     if let Some(manifold) = &mut manifold {
-                        result += manifold
-                            .at_scatter(scene, snee, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+                        result += manifold.at_scatter(cx, snee, &v);
                     }
                 }
 

@@ -34,12 +34,13 @@ pub mod stage;
 pub mod track;
 
 use super::desc::Integrator;
+use super::snee::stage::Scatter;
 use super::snee::{self, LightSample, Snee, SneeOptions, SneeSuffix, SneeTechnique, SneeTransport, SneeVertex};
 use super::stats::LocalStats;
+use super::volpath::Cx;
 use crate::color::Spectrum;
 use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
 use crate::math::{Ray, Vec2, Vec3};
-use crate::sampler::Sampler;
 use crate::scene::world::Scene;
 use flat::{on_plane, refract_into, FlatBoundary, Plane, Refraction};
 pub use stage::ManifoldStage;
@@ -178,24 +179,15 @@ pub fn connect(
     Some(ManifoldConnection { value, suffix: ManifoldSuffix { si_k, refraction, plane: *plane, d_jk, jacobian } })
 }
 
-/// The manifold stage at a real scatter `x_j` (depth `depth`, throughput `beta` including
-/// `sigma_s`): one emitter sample, every plane's solution, each MIS-weighted against SNEE run at
-/// the previous vertex `x_i` (when that was a SNEE vertex and no surface event came between) and,
-/// for an environment, against forward tracing. `None` when the connection does not run here
-/// (then its density is 0 for suffixes from `x_j`); it draws one 2-D sample whenever it runs.
-#[allow(clippy::too_many_arguments)]
-pub fn sample(
-    scene: &Scene,
-    opts: SneeOptions,
-    x_i: Option<&SneeVertex>,
-    x_j: MediumVertex,
-    beta: Spectrum,
-    depth: u32,
-    max_depth: u32,
-    channel: usize,
-    sampler: &mut Sampler,
-    stats: &mut LocalStats,
-) -> Option<Spectrum> {
+/// The manifold stage at a real scatter `v` (`x_j = v.p`): one emitter sample, every plane's
+/// solution, each MIS-weighted against SNEE run at the previous vertex `x_i` (when that was a
+/// SNEE vertex and no surface event came between) and, for an environment or an area light,
+/// against forward tracing. `None` when the connection does not run here (then its density is 0
+/// for suffixes from `x_j`); it draws one 2-D sample whenever it runs.
+pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scatter) -> Option<Spectrum> {
+    let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
+    let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
+    let (beta, depth, max_depth) = (v.beta, v.depth, v.max_depth);
     if !enabled(scene) {
         return None;
     }
@@ -287,22 +279,9 @@ fn sample_finite(
 
 impl Tracker {
     /// [`sample`], remembering `x_j` when the connection ran there (for forward paths' weights).
-    #[allow(clippy::too_many_arguments)]
-    pub fn sample(
-        &mut self,
-        scene: &Scene,
-        opts: SneeOptions,
-        x_i: Option<&SneeVertex>,
-        x_j: MediumVertex,
-        beta: Spectrum,
-        depth: u32,
-        max_depth: u32,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
-    ) -> Spectrum {
-        let r = sample(scene, opts, x_i, x_j, beta, depth, max_depth, channel, sampler, stats);
-        self.x_j = r.map(|_| x_j);
+    pub fn sample(&mut self, cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scatter) -> Spectrum {
+        let r = sample(cx, opts, x_i, v);
+        self.x_j = r.map(|_| MediumVertex { p: v.p, wi: v.wi, medium: v.medium });
         r.unwrap_or(Spectrum::ZERO)
     }
 }
