@@ -25,21 +25,7 @@ use snee::render::{render, RenderOptions};
 use std::sync::atomic::AtomicBool;
 
 fn cube(integrator: &str, bsdf: &str, emitter: &str) -> String {
-    format!(
-        r#"<scene version="3.0.0">
-<integrator type="{integrator}"><integer name="max_depth" value="-1"/></integrator>
-<sensor type="perspective"><float name="fov" value="40"/>
-    <transform name="to_world"><lookat origin="2.5, -3.5, 2.5" target="0, 0, 0" up="0, 0, 1"/></transform>
-    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="24"/></film></sensor>
-{emitter}
-<medium type="homogeneous" id="m"><float name="sigma_t" value="2"/>
-    <rgb name="albedo" value="0.9, 0.8, 0.7"/><phase type="hg"><float name="g" value="0.4"/></phase></medium>
-<shape type="cube">
-    <transform name="to_world"><rotate z="1" angle="20"/></transform>
-    {bsdf}
-    <ref name="interior" id="m"/></shape>
-</scene>"#
-    )
+    common::medium_cube(integrator, "", bsdf, emitter)
 }
 
 const DIRECTIONAL: &str = r#"<emitter type="directional"><vector name="direction" value="0.5, 0.4, -0.75"/><rgb name="irradiance" value="3, 3, 3"/></emitter>"#;
@@ -88,15 +74,12 @@ fn complete_agrees_with_volpath_under_envmap() {
     assert_eq!(mis.rejected + fwd.rejected, 0);
     assert!(mis.stats.len() > 1);
     // Two comparisons against the same reference: Šidák over 2.
-    let (r1, m_vp, m_mis) = welch_compare(&volpath, &mis, 0.01 / 2.0);
-    let (r2, _, m_fwd) = welch_compare(&volpath, &fwd, 0.01 / 2.0);
-    eprintln!(
-        "volpath {m_vp:?} (rel. s.e. {:.2} %)\ncomplete mis {m_mis:?} ({:.2} %)\ncomplete forward {m_fwd:?} ({:.2} %)",
-        100.0 * common::rel_std_error(&volpath),
-        100.0 * common::rel_std_error(&mis),
-        100.0 * common::rel_std_error(&fwd)
+    let report = common::agree_with_reference(
+        ("volpath", &volpath),
+        &[("complete mis", &mis), ("complete forward", &fwd)],
+        0.01,
     );
-    assert!(r1.is_empty() && r2.is_empty(), "volpath vs complete:\n{r1}\n{r2}");
+    assert!(report.is_empty(), "{report}");
 }
 
 #[test]
