@@ -1,7 +1,7 @@
 //! Manifold next-event estimation through a flat smooth boundary (`volpath_snee`,
 //! `connection = complete`): from every real scattering vertex inside a medium enclosed by a
-//! smooth `dielectric`, connect to a directional light or an environment through the refraction
-//! at the boundary. Derivation, densities and what is left out: `docs/manifold.md`.
+//! smooth `dielectric`, connect to a light (directional, environment, area, sphere, point, spot)
+//! through the refraction at the boundary. Derivation, densities and what is left out: `docs/manifold.md`.
 //!
 //! | Parameter    | Type   | Description                                                              |
 //! |--------------|--------|--------------------------------------------------------------------------|
@@ -14,11 +14,12 @@
 //! ```
 //!
 //! Inside a refractive boundary the ordinary NEE shadow ray is always blocked and returns 0; this
-//! technique takes its place. Under a directional light it makes suffixes no forward technique can
-//! make (a delta light behind a delta interface) and shares V–V–S_t–L suffixes with SNEE; under an
-//! environment it also shares them with forward tracing ([`mis`]). Scope (docs/manifold.md §6):
-//! directional lights and environments, boundaries made of flat facets ([`flat`]); elsewhere it
-//! draws no samples and `volpath_snee` is the paper's estimator.
+//! technique takes its place. Under a delta light (directional, point, spot) it makes suffixes no
+//! forward technique can make (a delta light behind a delta interface) and shares V–V–S_t–L
+//! suffixes with SNEE; under an environment or an area light it also shares them with forward
+//! tracing ([`mis`]). Lights at a finite distance: [`finite`]. Scope (docs/manifold.md §6):
+//! boundaries made of flat facets ([`flat`]); elsewhere it draws no samples and `volpath_snee` is
+//! the paper's estimator.
 //!
 //! The interface the volpath loop uses: a [`ManifoldStage`] per path next to SNEE's
 //! (`stage.rs`: [`sample`] at a medium vertex, the [`Tracker`] at surfaces, [`forward_weight`] for
