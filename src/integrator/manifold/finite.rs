@@ -5,8 +5,10 @@
 //! root (`flat::solve_point`); the value carries the generalized geometry term
 //! `G = dω_j/dA⊥(y)` (`pdf::plane_geometry`, Jakob & Marschner 2012):
 //!
-//!     area:        f_p(wi_j, ω_jk) T(d_jk) (1 − F) η² L_e(y) G cos θ_y / (p_sel p_A(y))
-//!     point, spot: f_p(wi_j, ω_jk) T(d_jk) (1 − F) η² I(−ω_l) G / p_sel
+//! ```text
+//! area:        f_p(wi_j, ω_jk) T(d_jk) (1 − F) η² L_e(y) G cos θ_y / (p_sel p_A(y))
+//! point, spot: f_p(wi_j, ω_jk) T(d_jk) (1 − F) η² I(−ω_l) G / p_sel
+//! ```
 //!
 //! (`(1 − F) η²`: the radiance through the interface, as for the directional light, §3).
 //! Spheres are sampled uniformly by area, not by the cone seen from `x_j` (Mitsuba's sampling for

@@ -166,7 +166,9 @@ pub fn refract_into(plane: &Plane, omega_l: Vec3) -> Option<Refraction> {
 /// to the plane, `D` the distance between the feet and `s` that of `x_k` from `x_j`'s foot,
 /// Snell's law `η sin θ_in = sin θ_l` reads
 ///
-///     g(s) = η s / √(a² + s²) − (D − s) / √(b² + (D − s)²) = 0,
+/// ```text
+/// g(s) = η s / √(a² + s²) − (D − s) / √(b² + (D − s)²) = 0,
+/// ```
 ///
 /// `g` increasing from `g(0) ≤ 0` to `g(D) ≥ 0`: Newton's method safeguarded by bisection,
 /// started from the paraxial solution `s = a D / (a + η b)`; in f64.

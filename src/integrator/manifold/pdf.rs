@@ -29,7 +29,9 @@ pub fn beam_factor(fresnel: f32, cos_l: f32, cos_in: f32) -> f32 {
 /// form). With `d_jk`, `d_ky` the two segment lengths, `θ_in`, `θ_l` the angles to the normal
 /// inside and outside and `η = η_int/η_ext` (`η sin θ_in = sin θ_l`):
 ///
-///     1/G = (d_jk + η d_ky) · (d_jk cos θ_l / cos θ_in + η d_ky cos θ_in / cos θ_l)
+/// ```text
+/// 1/G = (d_jk + η d_ky) · (d_jk cos θ_l / cos θ_in + η d_ky cos θ_in / cos θ_l)
+/// ```
 ///
 /// (`d²` for η = 1; `cos θ_l / (η² cos θ_in d_ky²)` as `d_ky → ∞`, the directional limit).
 #[inline]
