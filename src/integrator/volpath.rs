@@ -23,6 +23,7 @@
 
 use super::classes::{End, NoClasses, Tally};
 use super::manifold::ManifoldStage;
+use super::snee::stage::Scatter;
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
 use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, PathSetup, RefPoint, MAX_SEGMENTS};
@@ -440,15 +441,15 @@ pub fn trace<W: PathWeight, T: Tally>(
 
                 // ---- Subdivision next-event estimation (volpath_snee) ----
                 if let Some(snee) = &mut snee {
-                    let beta = weight.beta();
-                    let c = snee.at_scatter(scene, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+                    let v = Scatter { medium: mi, p, wi, depth, max_depth, beta: weight.beta() };
+                    let cx = &mut Cx { scene, channel, medium, sampler, stats, stages: Stages::default() };
+                    let c = snee.at_scatter(cx, &v);
                     result += c;
                     tally.add(scene, c, End::Snee);
 
                     // ---- Manifold next-event estimation (connection = complete) ----
                     if let Some(manifold) = &mut manifold {
-                        let c = manifold
-                            .at_scatter(scene, snee, mi, p, wi, depth, max_depth, beta, channel, sampler, stats);
+                        let c = manifold.at_scatter(cx, snee, &v);
                         result += c;
                         tally.add(scene, c, End::Manifold);
                     }

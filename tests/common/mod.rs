@@ -168,3 +168,41 @@ pub fn slab_scene(integrator: &str, direction: &str, albedo: f64, g: f64, bounda
 </scene>"#
     )
 }
+
+/// Compare several estimators with one reference (Welch, Šidák over the comparisons at family-wise
+/// `alpha`), print every image mean and relative standard error, and return the failures' report
+/// (empty when all agree).
+pub fn agree_with_reference(reference: (&str, &Batches), others: &[(&str, &Batches)], alpha: f64) -> String {
+    let alpha = 1.0 - (1.0 - alpha).powf(1.0 / others.len() as f64);
+    let mut report = String::new();
+    for (name, b) in others {
+        let (r, m_ref, m) = welch_compare(reference.1, b, alpha);
+        eprintln!("{} {m_ref:?} (rel. s.e. {:.2} %)", reference.0, 100.0 * rel_std_error(reference.1));
+        eprintln!("{name} {m:?} (rel. s.e. {:.2} %)", 100.0 * rel_std_error(b));
+        if !r.is_empty() {
+            report += &format!("{} vs {name}:\n{r}", reference.0);
+        }
+    }
+    report
+}
+
+/// A 24×24 view of a cube (rotated 20° about z) of grey HG medium (σt = 2, g = 0.4, albedo
+/// 0.9/0.8/0.7) with boundary `bsdf`, lit by `emitter`; `props` go into the `<integrator>` after
+/// `max_depth = -1` (the manifold tests).
+pub fn medium_cube(integrator: &str, props: &str, bsdf: &str, emitter: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
+<integrator type="{integrator}"><integer name="max_depth" value="-1"/>{props}</integrator>
+<sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="2.5, -3.5, 2.5" target="0, 0, 0" up="0, 0, 1"/></transform>
+    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="24"/></film></sensor>
+{emitter}
+<medium type="homogeneous" id="m"><float name="sigma_t" value="2"/>
+    <rgb name="albedo" value="0.9, 0.8, 0.7"/><phase type="hg"><float name="g" value="0.4"/></phase></medium>
+<shape type="cube">
+    <transform name="to_world"><rotate z="1" angle="20"/></transform>
+    {bsdf}
+    <ref name="interior" id="m"/></shape>
+</scene>"#
+    )
+}

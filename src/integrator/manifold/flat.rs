@@ -10,10 +10,9 @@
 
 use crate::bsdf::fresnel::{fresnel, refract};
 use crate::bsdf::Bsdf;
-use crate::emitter::Emitter;
 use crate::interaction::SurfaceInteraction;
 use crate::math::{Frame, Vec3};
-use crate::scene::world::{Scene, SceneEmitter};
+use crate::scene::world::Scene;
 use crate::shape::Geometry;
 
 /// Most distinct planes enumerated per connection (a cube has 6); more: the medium is not handled.
@@ -28,23 +27,46 @@ pub struct Plane {
     pub eta: f32,
 }
 
-/// The flat boundary of one medium: its distinct plane orientations.
+/// One supporting plane of the boundary: an orientation and its offset, the points `x` with
+/// `plane.n · x = offset` (lights at a finite distance need it: the refraction point depends on it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Support {
+    pub plane: Plane,
+    pub offset: f32,
+}
+
+/// The flat boundary of one medium: its distinct plane orientations, and its distinct supporting
+/// planes (empty when there are more than [`MAX_PLANES`]: then lights at a finite distance are not
+/// handled, directional lights and environments still are).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FlatBoundary {
     pub planes: Vec<Plane>,
+    pub supports: Vec<Support>,
+}
+
+impl FlatBoundary {
+    /// The supporting plane through the boundary point `p` with normal `n` and index `eta`.
+    pub fn support_at(&self, p: Vec3, n: Vec3, eta: f32) -> Option<&Support> {
+        self.supports
+            .iter()
+            .find(|s| s.plane.eta == eta && s.plane.n.dot(n) > SAME_NORMAL && same_offset(s.plane.n.dot(p), s.offset))
+    }
+}
+
+/// Two plane offsets (distances along the same normal) are the same plane.
+#[inline]
+fn same_offset(a: f32, b: f32) -> bool {
+    (a - b).abs() <= 1e-4 * (1.0 + a.abs().max(b.abs()))
 }
 
 /// Per medium of `scene`: its flat boundary, or `None` where the manifold connection does not
-/// apply (the scene has neither a directional light nor an environment, the medium does not sample emitters, is not
+/// apply (the scene has no emitter, the medium does not sample emitters, is not
 /// enclosed by a dielectric, or some enclosing shape is curved, shading-normal interpolated,
 /// rough, or has too many orientations). Where it is `None` the connection draws no samples, so
 /// `connection = complete` renders exactly what `paper` renders.
 pub fn flat_boundaries(scene: &Scene) -> Vec<Option<FlatBoundary>> {
-    let directional = scene.emitters.iter().any(|e| match e {
-        SceneEmitter::Other(e) => matches!(e, Emitter::Directional(_)) || e.is_environment(),
-        SceneEmitter::Area { .. } => false,
-    });
-    (0..scene.media.len() as u32).map(|m| if directional { flat_boundary(scene, m) } else { None }).collect()
+    let lit = !scene.emitters.is_empty();
+    (0..scene.media.len() as u32).map(|m| if lit { flat_boundary(scene, m) } else { None }).collect()
 }
 
 fn flat_boundary(scene: &Scene, medium: u32) -> Option<FlatBoundary> {
@@ -52,6 +74,7 @@ fn flat_boundary(scene: &Scene, medium: u32) -> Option<FlatBoundary> {
         return None;
     }
     let mut planes: Vec<Plane> = Vec::new();
+    let mut supports: Vec<Support> = Vec::new();
     let mut enclosed = false;
     for s in scene.shapes.iter().filter(|s| s.interior == Some(medium) && s.exterior.is_none()) {
         let eta = match &scene.bsdfs[s.bsdf as usize] {
@@ -87,9 +110,21 @@ fn flat_boundary(scene: &Scene, medium: u32) -> Option<FlatBoundary> {
                     return None;
                 }
             }
+            let offset = n.dot(p0);
+            if supports.len() <= MAX_PLANES
+                && !supports
+                    .iter()
+                    .any(|s| s.plane.eta == eta && s.plane.n.dot(n) > SAME_NORMAL && same_offset(offset, s.offset))
+            {
+                // One past the limit marks "too many" (cleared below).
+                supports.push(Support { plane: Plane { n, eta }, offset });
+            }
         }
     }
-    (enclosed && !planes.is_empty()).then_some(FlatBoundary { planes })
+    if supports.len() > MAX_PLANES {
+        supports.clear();
+    }
+    (enclosed && !planes.is_empty()).then_some(FlatBoundary { planes, supports })
 }
 
 /// Refraction of the light direction through a plane (Snell, the closed form of the constraint).
@@ -121,6 +156,60 @@ pub fn refract_into(plane: &Plane, omega_l: Vec3) -> Option<Refraction> {
     let omega_in = frame.to_world(refract(wl, cos_t, eta_ti)).normalize();
     let cos_in = -plane.n.dot(omega_in);
     (cos_in > 0.0).then_some(Refraction { omega_in, fresnel: f, cos_l, cos_in })
+}
+
+/// The refraction point `x_k` on the supporting plane `s` of the path `x_j → x_k → y` from a
+/// point `x_j` inside (below the plane) to a point `y` outside (above it); `None` when `x_j` or
+/// `y` is on the wrong side. On a plane the solution is unique (Fermat's principle: the optical
+/// length `η_int |x_j x_k| + η_ext |x_k y|` is strictly convex in `x_k`) and lies in the plane
+/// of incidence, on the segment between the feet of `x_j` and `y`. With `a`, `b` their distances
+/// to the plane, `D` the distance between the feet and `s` that of `x_k` from `x_j`'s foot,
+/// Snell's law `η sin θ_in = sin θ_l` reads
+///
+/// ```text
+/// g(s) = η s / √(a² + s²) − (D − s) / √(b² + (D − s)²) = 0,
+/// ```
+///
+/// `g` increasing from `g(0) ≤ 0` to `g(D) ≥ 0`: Newton's method safeguarded by bisection,
+/// started from the paraxial solution `s = a D / (a + η b)`; in f64.
+pub fn solve_point(s: &Support, x_j: Vec3, y: Vec3) -> Option<Vec3> {
+    let n = s.plane.n.as_dvec3();
+    let (x_j, y) = (x_j.as_dvec3(), y.as_dvec3());
+    let offset = s.offset as f64;
+    let (a, b) = (offset - n.dot(x_j), n.dot(y) - offset);
+    if !(a > 0.0 && b > 0.0) {
+        return None;
+    }
+    let foot_j = x_j + n * a;
+    let v = (y - n * b) - foot_j;
+    let d = v.length();
+    if !(d > 1e-12 * (a + b)) {
+        return Some(foot_j.as_vec3());
+    }
+    let u = v / d;
+    let eta = s.plane.eta as f64;
+    let (mut lo, mut hi) = (0.0f64, d);
+    let mut x = a * d / (a + eta * b);
+    for _ in 0..100 {
+        let (ra, rb) = ((a * a + x * x).sqrt(), (b * b + (d - x) * (d - x)).sqrt());
+        let g = eta * x / ra - (d - x) / rb;
+        if g > 0.0 {
+            hi = x;
+        } else {
+            lo = x;
+        }
+        let dg = eta * a * a / (ra * ra * ra) + b * b / (rb * rb * rb);
+        let mut next = x - g / dg;
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        let done = (next - x).abs() <= 1e-13 * d || hi - lo <= 1e-13 * d;
+        x = next;
+        if done {
+            break;
+        }
+    }
+    Some((foot_j + u * x).as_vec3())
 }
 
 /// Is `si` (hit from inside `medium` along `d`) a point of `plane`'s orientation on a boundary

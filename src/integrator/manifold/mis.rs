@@ -1,12 +1,12 @@
-//! MIS of the manifold connection to an ENVIRONMENT (envmap, constant) with the other techniques
-//! that make the same suffix `x_j → x_k → environment` (docs/manifold.md §4.2):
+//! MIS of the manifold connection to a NON-DELTA light (an environment, or an area / sphere light)
+//! with the other techniques that make the same suffix `x_j → x_k → light` (docs/manifold.md §4.2):
 //! forward tracing (phase sampling at `x_j`, free flight surviving to `x_k`, the refraction chosen
 //! with probability `1 − F`, escape), and SNEE at `x_i` when `x_i → x_j → x_k` is in its support.
 //! All three densities are taken in the solid angle of `omega_jk` at `x_j` (conditioned on `x_j`):
 //!
 //! | technique | density |
 //! |---|---|
-//! | manifold | `p_env(omega_l) · dω_l/dω_in = p_env · η² cos θ_in / cos θ_l` |
+//! | manifold | environment: `p_env(omega_l) · dω_l/dω_in = p_env · η² cos θ_in / cos θ_l`; area light: `p_sel p_A(y) / (G cos θ_y)` ([`area_density`]) |
 //! | forward  | `f_p(wi_j, omega_jk) · e^{−σ_t d_jk} · (1 − F)` |
 //! | SNEE     | `pdf_snee / (p_V(x_j | x_i) · cos θ_k / d_jk²)` (its `dV(x_j) dA(x_k)` density over forward's density of `x_j`, and `dA(x_k) = d_jk²/cos θ_k dω_jk`) |
 
@@ -50,18 +50,34 @@ fn p_volume(scene: &Scene, x_i: &SneeVertex, x_j: Vec3, channel: usize) -> f64 {
     pdf::manifold_density(1.0, m.phase.eval(x_i.wi, v / t), m.sigma_t[channel], t, 1.0)
 }
 
-/// The densities of `x_j → x_k → environment` (plus `x_i` before, when given). `check_support`:
+/// The manifold connection's density of an environment direction (solid angle at `x_j`).
+#[inline]
+pub fn env_density(light: &LightSample, plane: &Plane, r: &Refraction) -> f64 {
+    let eta2 = (plane.eta as f64) * (plane.eta as f64);
+    light.p_light as f64 * eta2 * r.cos_in as f64 / r.cos_l as f64
+}
+
+/// The manifold connection's density of a light point `y` on an area light (solid angle at
+/// `x_j`): `p_y / (G cos θ_y)`, `p_y = p_sel p_A(y)` the density of the point it samples (by
+/// area), `G` the generalized geometry term (`pdf::plane_geometry`).
+#[inline]
+pub fn area_density(p_y: f64, g: f64, cos_y: f32) -> f64 {
+    p_y / (g * cos_y.abs() as f64)
+}
+
+/// The densities of `x_j → x_k → light` (plus `x_i` before, when given), the manifold
+/// connection's (`manifold`: [`env_density`] or [`area_density`]) given. `check_support`:
 /// test that `x_k` is visible from `x_i` (SNEE's probe); the caller passes `false` when it knows.
 #[allow(clippy::too_many_arguments)]
-pub fn env_pdfs(
+pub fn suffix_pdfs(
     scene: &Scene,
     opts: SneeOptions,
     x_i: Option<&SneeVertex>,
     x_j: &MediumVertex,
     si_k: &SurfaceInteraction,
-    plane: &Plane,
     r: &Refraction,
     light: &LightSample,
+    manifold: f64,
     channel: usize,
     check_support: bool,
     stats: &mut LocalStats,
@@ -71,8 +87,6 @@ pub fn env_pdfs(
     let d_jk = v.length();
     let omega_jk = v / d_jk;
     let st = m.sigma_t[channel] as f64;
-    let eta2 = (plane.eta as f64) * (plane.eta as f64);
-    let manifold = light.p_light as f64 * eta2 * r.cos_in as f64 / r.cos_l as f64;
     let forward = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp() * (1.0 - r.fresnel as f64);
     let mut snee = 0.0;
     if let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) {

@@ -1,7 +1,7 @@
 //! Manifold next-event estimation through a flat smooth boundary (`volpath_snee`,
 //! `connection = complete`): from every real scattering vertex inside a medium enclosed by a
-//! smooth `dielectric`, connect to a directional light or an environment through the refraction
-//! at the boundary. Derivation, densities and what is left out: `docs/manifold.md`.
+//! smooth `dielectric`, connect to a light (directional, environment, area, sphere, point, spot)
+//! through the refraction at the boundary. Derivation, densities and what is left out: `docs/manifold.md`.
 //!
 //! | Parameter    | Type   | Description                                                              |
 //! |--------------|--------|--------------------------------------------------------------------------|
@@ -14,11 +14,12 @@
 //! ```
 //!
 //! Inside a refractive boundary the ordinary NEE shadow ray is always blocked and returns 0; this
-//! technique takes its place. Under a directional light it makes suffixes no forward technique can
-//! make (a delta light behind a delta interface) and shares V–V–S_t–L suffixes with SNEE; under an
-//! environment it also shares them with forward tracing ([`mis`]). Scope (docs/manifold.md §6):
-//! directional lights and environments, boundaries made of flat facets ([`flat`]); elsewhere it
-//! draws no samples and `volpath_snee` is the paper's estimator.
+//! technique takes its place. Under a delta light (directional, point, spot) it makes suffixes no
+//! forward technique can make (a delta light behind a delta interface) and shares V–V–S_t–L
+//! suffixes with SNEE; under an environment or an area light it also shares them with forward
+//! tracing ([`mis`]). Lights at a finite distance: [`finite`]. Scope (docs/manifold.md §6):
+//! boundaries made of flat facets ([`flat`]); elsewhere it draws no samples and `volpath_snee` is
+//! the paper's estimator.
 //!
 //! The interface the volpath loop uses: a [`ManifoldStage`] per path next to SNEE's
 //! (`stage.rs`: [`sample`] at a medium vertex, the [`Tracker`] at surfaces, [`forward_weight`] for
@@ -26,6 +27,7 @@
 //! `snee/sample.rs`). The flat boundaries are built at scene load into `volpath_snee`'s tables
 //! ([`Snee::flat`], read through [`tables`]).
 
+pub mod finite;
 pub mod flat;
 pub mod mis;
 pub mod pdf;
@@ -33,12 +35,13 @@ pub mod stage;
 pub mod track;
 
 use super::desc::Integrator;
+use super::snee::stage::Scatter;
 use super::snee::{self, LightSample, Snee, SneeOptions, SneeSuffix, SneeTechnique, SneeTransport, SneeVertex};
 use super::stats::LocalStats;
+use super::volpath::Cx;
 use crate::color::Spectrum;
 use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
 use crate::math::{Ray, Vec2, Vec3};
-use crate::sampler::Sampler;
 use crate::scene::world::Scene;
 use flat::{on_plane, refract_into, FlatBoundary, Plane, Refraction};
 pub use stage::ManifoldStage;
@@ -80,6 +83,9 @@ pub struct ManifoldSuffix {
     pub plane: Plane,
     /// Distance `x_j → x_k`.
     pub d_jk: f32,
+    /// `dV(x_j) / (dA(x_k) dt)` for a delta light: `cos θ_in` (directional), `pdf::point_jacobian`
+    /// (point, spot).
+    pub jacobian: f32,
 }
 
 /// One solution of the connection: its contribution `f / p_sel` without the path throughput and
@@ -170,27 +176,19 @@ pub fn connect(
         * pdf::beam_factor(refraction.fresnel, refraction.cos_l, refraction.cos_in)
         * tr_out
         * weight;
-    Some(ManifoldConnection { value, suffix: ManifoldSuffix { si_k, refraction, plane: *plane, d_jk } })
+    let jacobian = refraction.cos_in;
+    Some(ManifoldConnection { value, suffix: ManifoldSuffix { si_k, refraction, plane: *plane, d_jk, jacobian } })
 }
 
-/// The manifold stage at a real scatter `x_j` (depth `depth`, throughput `beta` including
-/// `sigma_s`): one emitter sample, every plane's solution, each MIS-weighted against SNEE run at
-/// the previous vertex `x_i` (when that was a SNEE vertex and no surface event came between) and,
-/// for an environment, against forward tracing. `None` when the connection does not run here
-/// (then its density is 0 for suffixes from `x_j`); it draws one 2-D sample whenever it runs.
-#[allow(clippy::too_many_arguments)]
-pub fn sample(
-    scene: &Scene,
-    opts: SneeOptions,
-    x_i: Option<&SneeVertex>,
-    x_j: MediumVertex,
-    beta: Spectrum,
-    depth: u32,
-    max_depth: u32,
-    channel: usize,
-    sampler: &mut Sampler,
-    stats: &mut LocalStats,
-) -> Option<Spectrum> {
+/// The manifold stage at a real scatter `v` (`x_j = v.p`): one emitter sample, every plane's
+/// solution, each MIS-weighted against SNEE run at the previous vertex `x_i` (when that was a
+/// SNEE vertex and no surface event came between) and, for an environment or an area light,
+/// against forward tracing. `None` when the connection does not run here (then its density is 0
+/// for suffixes from `x_j`); it draws one 2-D sample whenever it runs.
+pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scatter) -> Option<Spectrum> {
+    let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
+    let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
+    let (beta, depth, max_depth) = (v.beta, v.depth, v.max_depth);
     if !enabled(scene) {
         return None;
     }
@@ -201,6 +199,13 @@ pub fn sample(
         return None;
     }
     stats.manifold_attempts += 1;
+    match finite::pick(scene, u) {
+        finite::Pick::Nothing => return Some(Spectrum::ZERO),
+        finite::Pick::Finite(lp) => {
+            return Some(sample_finite(scene, opts, x_i, &x_j, boundary, &lp, beta, channel, stats))
+        }
+        finite::Pick::Distant => {}
+    }
     let (ds, weight) = scene.sample_emitter_direction(x_j.p, None, u, false);
     // Directional lights (delta, infinitely far) and environments (non-delta, infinitely far).
     if !(ds.pdf > 0.0) || ds.dist.is_finite() || weight == Spectrum::ZERO {
@@ -215,19 +220,9 @@ pub fn sample(
         let Some(c) = connect(scene, &x_j, plane, ds.d, weight, stats) else { continue };
         let w = if environment {
             let Some(light) = mis::env_light(scene, &c.suffix.si_k, ds.d) else { continue };
-            let p = mis::env_pdfs(
-                scene,
-                opts,
-                x_i,
-                &x_j,
-                &c.suffix.si_k,
-                plane,
-                &c.suffix.refraction,
-                &light,
-                channel,
-                true,
-                stats,
-            );
+            let (si_k, r) = (&c.suffix.si_k, &c.suffix.refraction);
+            let p_man = mis::env_density(&light, plane, r);
+            let p = mis::suffix_pdfs(scene, opts, x_i, &x_j, si_k, r, &light, p_man, channel, true, stats);
             mis::env_weight(opts, mis::EnvTechnique::Manifold, p)
         } else {
             let light =
@@ -244,53 +239,96 @@ pub fn sample(
     Some(result)
 }
 
+/// The manifold stage's connections to a light point at a finite distance (`lp`), one per
+/// supporting plane of the boundary (docs/manifold.md §3.2), MIS-weighted: an area light against
+/// forward tracing and SNEE (three-way, [`mis::env_weight`]), a point or spot light against SNEE.
+#[allow(clippy::too_many_arguments)]
+fn sample_finite(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    boundary: &FlatBoundary,
+    lp: &finite::LightPoint,
+    beta: Spectrum,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Spectrum {
+    let mut result = Spectrum::ZERO;
+    for s in &boundary.supports {
+        let Some(c) = finite::connect(scene, x_j, s, lp, stats) else { continue };
+        let w = if lp.area.is_some() {
+            let p_man = mis::area_density(lp.p_y, c.g, c.cos_y);
+            let p =
+                mis::suffix_pdfs(scene, opts, x_i, x_j, &c.si_k, &c.refraction, &c.light, p_man, channel, true, stats);
+            mis::env_weight(opts, mis::EnvTechnique::Manifold, p)
+        } else {
+            let jacobian = pdf::point_jacobian(c.light.dist, c.refraction.cos_l, s.plane.eta, c.g);
+            let suffix =
+                ManifoldSuffix { si_k: c.si_k, refraction: c.refraction, plane: s.plane, d_jk: c.d_jk, jacobian };
+            weight_against_snee(scene, opts, x_i, x_j, &suffix, &c.light, channel, stats)
+        };
+        let contribution = beta * c.value * w as f32;
+        if crate::color::is_finite(contribution) {
+            result += contribution;
+        } else {
+            stats.rejected_samples += 1;
+        }
+    }
+    result
+}
+
 impl Tracker {
     /// [`sample`], remembering `x_j` when the connection ran there (for forward paths' weights).
-    #[allow(clippy::too_many_arguments)]
-    pub fn sample(
-        &mut self,
-        scene: &Scene,
-        opts: SneeOptions,
-        x_i: Option<&SneeVertex>,
-        x_j: MediumVertex,
-        beta: Spectrum,
-        depth: u32,
-        max_depth: u32,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
-    ) -> Spectrum {
-        let r = sample(scene, opts, x_i, x_j, beta, depth, max_depth, channel, sampler, stats);
-        self.x_j = r.map(|_| x_j);
+    pub fn sample(&mut self, cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scatter) -> Spectrum {
+        let r = sample(cx, opts, x_i, v);
+        self.x_j = r.map(|_| MediumVertex { p: v.p, wi: v.wi, medium: v.medium });
         r.unwrap_or(Spectrum::ZERO)
     }
 }
 
-/// The weight of a forward path that escaped to the environment along `omega_l` right after
-/// leaving `x_j`'s medium through a flat plane (`pending`), against the manifold connection and
-/// SNEE (docs/manifold.md §4.2); `None` where the manifold connection cannot make the path (the
-/// caller's weight stands). `snee_pending`: SNEE's record of the same path, when `x_i` was a
-/// SNEE vertex.
+/// The weight of a forward path that reached a light along `omega_l` right after leaving `x_j`'s
+/// medium through a flat plane (`pending`): the environment (`hit` is `None`: it escaped) or an
+/// area light (`hit` on it), against the manifold connection and SNEE (docs/manifold.md §4.2);
+/// `None` where the manifold connection cannot make the path (the caller's weight stands).
+/// `snee_pending`: SNEE's record of the same path, when `x_i` was a SNEE vertex.
 #[allow(clippy::too_many_arguments)]
 pub fn forward_weight(
     scene: &Scene,
     opts: Option<SneeOptions>,
     pending: Option<&track::Pending>,
     snee_pending: Option<&SneeSuffix>,
-    escaped: bool,
+    hit: Option<&SurfaceInteraction>,
     omega_l: Vec3,
     channel: usize,
     stats: &mut LocalStats,
 ) -> Option<f32> {
     let (opts, pending) = (opts?, pending?);
-    if !escaped || !enabled(scene) {
+    if !enabled(scene) {
         return None;
     }
-    let light = mis::env_light(scene, &pending.si_k, omega_l)?;
     let r = refract_into(&pending.plane, omega_l)?;
+    let si_k = &pending.si_k;
+    let (light, p_man) = match hit {
+        None => {
+            let light = mis::env_light(scene, si_k, omega_l)?;
+            let p_man = mis::env_density(&light, &pending.plane, &r);
+            (light, p_man)
+        }
+        Some(y) => {
+            scene.shapes[y.shape as usize].emitter?;
+            boundary_of(scene, pending.x_j.medium)?.support_at(si_k.p, si_k.n, pending.plane.eta)?;
+            let d_ky = (y.p - si_k.p).length();
+            let ds = scene.direction_sample_for_hit(si_k.p, y);
+            let light = LightSample::hit(omega_l, y.p, d_ky, scene.pdf_emitter_direction(si_k.p, &ds));
+            let (p_y, cos_y) = finite::area_point_density(scene, y, omega_l);
+            let d_jk = (si_k.p - pending.x_j.p).length();
+            let g = pdf::plane_geometry(d_jk, d_ky, r.cos_in, r.cos_l, pending.plane.eta);
+            (light, mis::area_density(p_y, g, cos_y))
+        }
+    };
     let x_i = snee_pending.filter(|s| s.x_j == pending.x_j.p).map(|s| &s.x_i);
-    let p =
-        mis::env_pdfs(scene, opts, x_i, &pending.x_j, &pending.si_k, &pending.plane, &r, &light, channel, true, stats);
+    let p = mis::suffix_pdfs(scene, opts, x_i, &pending.x_j, si_k, &r, &light, p_man, channel, true, stats);
     Some(mis::env_weight(opts, mis::EnvTechnique::Forward, p) as f32)
 }
 
@@ -315,13 +353,8 @@ fn weight_against_snee(
     let m = &scene.media[x_j.medium as usize];
     let v_ij = x_j.p - x_i.p;
     let t_ij = v_ij.length();
-    let p_man = pdf::manifold_density(
-        light.p_light,
-        m.phase.eval(x_i.wi, v_ij / t_ij),
-        m.sigma_t[channel],
-        t_ij,
-        s.refraction.cos_in,
-    );
+    let p_man =
+        pdf::manifold_density(light.p_light, m.phase.eval(x_i.wi, v_ij / t_ij), m.sigma_t[channel], t_ij, s.jacobian);
     pdf::manifold_weight(opts.technique, p_man, p_snee)
 }
 
@@ -355,9 +388,9 @@ fn snee_density(
 }
 
 /// SNEE's full MIS weight for a suffix SNEE made that the manifold connection can also make, or
-/// `None` (SNEE's own weight stands). Directional light: only SNEE and the manifold connection
-/// make it (forward tracing cannot), two-way power heuristic in `dt dA(x_k)`; environment: the
-/// three-way weight of [`mis::env_weight`].
+/// `None` (SNEE's own weight stands). Delta lights (directional, point, spot): only SNEE and the
+/// manifold connection make it (forward tracing cannot), two-way power heuristic in `dt dA(x_k)`;
+/// environments and area lights: the three-way weight of [`mis::env_weight`].
 pub fn snee_weight(
     scene: &Scene,
     technique: SneeTechnique,
@@ -366,31 +399,49 @@ pub fn snee_weight(
     channel: usize,
     pdf_snee: f64,
 ) -> Option<f64> {
-    if !enabled(scene) || light.dist.is_finite() {
+    if !enabled(scene) {
         return None;
     }
     let boundary = boundary_of(scene, s.x_i.medium)?;
     let si_k = &s.si_k;
     let crate::bsdf::Bsdf::Dielectric(d) = scene.bsdf(si_k) else { return None };
     let plane = boundary.planes.iter().find(|p| si_k.n.dot(p.n) > flat::SAME_NORMAL && d.eta == p.eta)?;
+    let finite = light.dist.is_finite();
+    if finite {
+        // The connection to a finite light enumerates supporting planes (none when too many).
+        boundary.support_at(si_k.p, si_k.n, d.eta)?;
+    }
     let r = refract_into(plane, light.omega_l)?;
     let m = &scene.media[s.x_i.medium as usize];
     let v_ij = s.x_j - s.x_i.p;
     let t_ij = v_ij.length();
+    let t_kj = (s.x_j - si_k.p).length();
     if !light.delta {
-        scene.environment?;
+        let p_man = if finite {
+            let (p_y, cos_y) = finite::area_point(scene, si_k, light.omega_l)?;
+            let g = pdf::plane_geometry(t_kj, light.dist, r.cos_in, r.cos_l, plane.eta);
+            mis::area_density(p_y, g, cos_y)
+        } else {
+            scene.environment?;
+            mis::env_density(light, plane, &r)
+        };
         let opts = SneeOptions { technique, ..scene.integrator.snee };
         let x_j = MediumVertex { p: s.x_j, wi: -v_ij / t_ij, medium: s.x_i.medium };
         // No support check: no rays traced, nothing to count.
         let mut no_rays = LocalStats::default();
-        let p = mis::env_pdfs(scene, opts, Some(&s.x_i), &x_j, si_k, plane, &r, light, channel, false, &mut no_rays);
+        let p = mis::suffix_pdfs(scene, opts, Some(&s.x_i), &x_j, si_k, &r, light, p_man, channel, false, &mut no_rays);
         return Some(mis::env_weight(opts, mis::EnvTechnique::Snee, p));
     }
     // The manifold connection runs at x_j if x_j's depth leaves room for x_k: the same condition
     // as x_i being a SNEE vertex, which it is here.
+    let jacobian = if finite {
+        let g = pdf::plane_geometry(t_kj, light.dist, r.cos_in, r.cos_l, plane.eta);
+        pdf::point_jacobian(light.dist, r.cos_l, plane.eta, g)
+    } else {
+        r.cos_in
+    };
     let p_man =
-        pdf::manifold_density(light.p_light, m.phase.eval(s.x_i.wi, v_ij / t_ij), m.sigma_t[channel], t_ij, r.cos_in);
-    let t_kj = (s.x_j - si_k.p).length();
+        pdf::manifold_density(light.p_light, m.phase.eval(s.x_i.wi, v_ij / t_ij), m.sigma_t[channel], t_ij, jacobian);
     let p_snee = pdf::snee_density(pdf_snee, t_kj, pdf::solid_angle_ratio(r.cos_l, r.cos_in, plane.eta));
     Some(pdf::snee_weight(technique, p_snee, p_man))
 }

@@ -13,14 +13,15 @@
 //! `snee/sample.rs` (`manifold::snee_weight`).
 
 use super::track::{Pending, Tracker};
-use super::{forward_weight, Connection, MediumVertex};
+use super::{forward_weight, Connection};
 use crate::bsdf::BsdfSample;
 use crate::color::Spectrum;
+use crate::integrator::snee::stage::Scatter;
 use crate::integrator::snee::{Snee, SneeStage};
 use crate::integrator::stats::LocalStats;
+use crate::integrator::volpath::Cx;
 use crate::interaction::SurfaceInteraction;
 use crate::math::Vec3;
-use crate::sampler::Sampler;
 use crate::scene::world::Scene;
 
 /// The manifold connection's state along one path.
@@ -31,8 +32,8 @@ pub struct ManifoldStage<'a> {
     tracker: Tracker,
     /// The pending suffix as it was when the ray reached the current surface (or escaped).
     arrived: Option<Pending>,
-    /// Did the current ray escape the scene (an environment hit)?
-    escaped: bool,
+    /// The surface the current ray reached (`None`: it escaped, an environment hit).
+    hit: Option<SurfaceInteraction>,
 }
 
 impl<'a> ManifoldStage<'a> {
@@ -42,39 +43,22 @@ impl<'a> ManifoldStage<'a> {
             snee,
             tracker: Tracker::default(),
             arrived: None,
-            escaped: false,
+            hit: None,
         })
     }
 
-    /// At a real scatter `x_j = p` (depth `depth`) in `medium`, after SNEE's stage ran there (its
-    /// chain gives `x_i`): one connection. Returns its contribution (`beta`: the throughput at
-    /// `p` including `sigma_s`).
-    #[allow(clippy::too_many_arguments)]
+    /// At a real scatter `v` (`x_j = v.p`), after SNEE's stage ran there (its chain gives `x_i`):
+    /// one connection. Returns its contribution.
     #[inline]
-    pub fn at_scatter(
-        &mut self,
-        scene: &Scene,
-        snee: &SneeStage,
-        medium: u32,
-        p: Vec3,
-        wi: Vec3,
-        depth: u32,
-        max_depth: u32,
-        beta: Spectrum,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
-    ) -> Spectrum {
-        let x_j = MediumVertex { p, wi, medium };
-        let opts = self.snee.options;
-        self.tracker.sample(scene, opts, snee.chain_x_i(), x_j, beta, depth, max_depth, channel, sampler, stats)
+    pub fn at_scatter(&mut self, cx: &mut Cx, snee: &SneeStage, v: &Scatter) -> Spectrum {
+        self.tracker.sample(cx, self.snee.options, snee.chain_x_i(), v)
     }
 
     /// The ray reached a surface (`None`: it escaped).
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.arrived = self.tracker.surface_event();
-        self.escaped = si.is_none();
+        self.hit = si.copied();
     }
 
     /// The weight of an emitter hit along `d` by forward tracing, when the manifold connection
@@ -89,7 +73,7 @@ impl<'a> ManifoldStage<'a> {
         stats: &mut LocalStats,
     ) -> Option<f32> {
         let opts = Some(self.snee.options);
-        forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.escaped, d, channel, stats)
+        forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.hit.as_ref(), d, channel, stats)
     }
 
     /// BSDF sampling at `s` chose `bs` towards `wo`.

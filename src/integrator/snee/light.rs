@@ -71,6 +71,11 @@ pub fn light_transmission(
 
 /// True when the open segment `a → b` crosses no surface.
 pub fn segment_clear(scene: &Scene, a: Vec3, b: Vec3, stats: &mut LocalStats) -> bool {
+    // An empty segment (x_j sampled onto x_i in f32) crosses nothing; a ray along it would have a
+    // NaN direction.
+    if !(a.distance_squared(b) > 0.0) {
+        return true;
+    }
     stats.rays += 1;
     !scene.ray_test(&spawn_ray_between(a, b))
 }

@@ -17,10 +17,24 @@ use crate::bsdf::{flags, BsdfSample};
 use crate::color::Spectrum;
 use crate::integrator::stats::LocalStats;
 use crate::integrator::technique::Technique;
+use crate::integrator::volpath::Cx;
 use crate::interaction::SurfaceInteraction;
 use crate::math::Vec3;
-use crate::sampler::Sampler;
 use crate::scene::world::Scene;
+
+/// A real scatter of the path as the stages at medium vertices see it (SNEE's and the manifold
+/// connection's `at_scatter`).
+#[derive(Clone, Copy, Debug)]
+pub struct Scatter {
+    pub medium: u32,
+    pub p: Vec3,
+    /// Direction back to the previous vertex (the phase function's `wi`).
+    pub wi: Vec3,
+    pub depth: u32,
+    pub max_depth: u32,
+    /// The throughput at `p`, including `sigma_s`.
+    pub beta: Spectrum,
+}
 
 /// SNEE's state along one path.
 #[derive(Clone, Debug)]
@@ -49,29 +63,15 @@ impl<'a> SneeStage<'a> {
         self.snee.options.keeps_all()
     }
 
-    /// At a real scatter `p` (depth `depth`) in `medium`: the chain `x_i → x_j = p` if `x_i` was the
-    /// last vertex, `p` as the new `x_i`, and one SNEE sample there. Returns its contribution
-    /// (`beta` is the throughput at `p` including `sigma_s`).
-    #[allow(clippy::too_many_arguments)]
+    /// At a real scatter `v` of the path: the chain `x_i → x_j = v.p` if `x_i` was the last
+    /// vertex, `v.p` as the new `x_i`, and one SNEE sample there. Returns its contribution.
     #[inline]
-    pub fn at_scatter(
-        &mut self,
-        scene: &Scene,
-        medium: u32,
-        p: Vec3,
-        wi: Vec3,
-        depth: u32,
-        max_depth: u32,
-        beta: Spectrum,
-        channel: usize,
-        sampler: &mut Sampler,
-        stats: &mut LocalStats,
-    ) -> Spectrum {
-        self.chain = self.x_i.take().map(|x_i| (x_i, p));
-        self.x_i = snee_vertex(self.snee, medium, p, wi, depth, max_depth);
+    pub fn at_scatter(&mut self, cx: &mut Cx, v: &Scatter) -> Spectrum {
+        self.chain = self.x_i.take().map(|x_i| (x_i, v.p));
+        self.x_i = snee_vertex(self.snee, v.medium, v.p, v.wi, v.depth, v.max_depth);
         match &self.x_i {
             Some(x_i) if self.snee.options.technique != SneeTechnique::Forward => {
-                self.snee.sample(scene, x_i, beta, channel, sampler, stats)
+                self.snee.sample(cx.scene, x_i, v.beta, cx.channel, cx.sampler, cx.stats)
             }
             _ => Spectrum::ZERO,
         }
