@@ -122,6 +122,10 @@ impl Accel {
 
     /// Closest hit along the ray in (0, ray.tmax).
     pub fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
+        // A NaN or infinite ray has no hit; the traversal's nearest-first order needs finite distances.
+        if !ray_is_finite(ray) {
+            return None;
+        }
         let mut best = None;
         let mut tmax = ray.tmax;
         for &si in &self.analytic {
@@ -142,6 +146,10 @@ impl Accel {
 
     /// True when anything blocks the ray in (0, ray.tmax).
     pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
+        // A NaN or infinite ray carries no light: report it blocked.
+        if !ray_is_finite(ray) {
+            return true;
+        }
         for &si in &self.analytic {
             if intersect_analytic(&shapes[si as usize], ray, ray.tmax) < ray.tmax {
                 return true;
@@ -202,3 +210,9 @@ fn intersect_analytic(shape: &Shape, ray: &Ray, tmax: f32) -> f32 {
 
 #[cfg(test)]
 mod tests;
+
+/// Origin and direction finite (a sum is non-finite when either part is, even ±inf cancelling to NaN).
+#[inline(always)]
+fn ray_is_finite(ray: &Ray) -> bool {
+    (ray.o + ray.d).is_finite()
+}

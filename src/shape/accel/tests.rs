@@ -125,3 +125,23 @@ fn traversal_equals_brute_force() {
         }
     }
 }
+
+/// Rays with NaN or infinite origin or direction (e.g. from a zero-length segment) neither panic
+/// nor hit: `intersect` finds nothing and `occluded` calls them blocked.
+#[test]
+fn non_finite_rays_do_not_panic() {
+    let shapes = soup(5, 500, 10.0);
+    for isa in [Isa::Portable, Isa::detect()] {
+        let accel = Accel::build_with(&shapes, isa);
+        let bad = [
+            Ray { o: Vec3::splat(5.0), d: Vec3::splat(f32::NAN), tmax: f32::INFINITY },
+            Ray { o: Vec3::new(f32::NAN, 5.0, 5.0), d: Vec3::X, tmax: 1.0 },
+            Ray { o: Vec3::splat(5.0), d: Vec3::new(f32::INFINITY, 0.0, 0.0), tmax: f32::INFINITY },
+            Ray { o: Vec3::new(f32::NEG_INFINITY, 5.0, 5.0), d: Vec3::X, tmax: f32::INFINITY },
+        ];
+        for r in &bad {
+            assert!(accel.intersect(&shapes, r).is_none(), "ray {r:?}");
+            assert!(accel.occluded(&shapes, r), "ray {r:?}");
+        }
+    }
+}
