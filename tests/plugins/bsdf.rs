@@ -7,7 +7,7 @@
 //! `scripts/bsdf_point_values.py` (`scalar_rgb` variant, hand-built `SurfaceInteraction3f` with
 //! the shading frame = world frame, so `wi`/`wo` are local).
 
-use crate::{beckmann_visible_pdf_scale, bsdf_desc, close, load_bsdf, mitsuba_json, num, uint, vec2, vec3};
+use crate::{beckmann_visible_pdf_scale, bsdf_desc, close, load_bsdf, mitsuba_json, num, uint, vec2, vec3, BsdfChi2};
 use serde_json::Value as Json;
 use snee::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use snee::color::{luminance, Spectrum};
@@ -35,28 +35,6 @@ fn rough(ggx: bool, alpha_u: f32, alpha_v: f32, int_ior: f32, ext_ior: f32, visi
 
 // ---- Chi-square: sampling routine against pdf ----
 
-/// Chi-square of `bsdf.sample` against `bsdf.pdf / pdf_scale` for one `wi`.
-fn chi2_bsdf_scaled(
-    bsdf: &Bsdf,
-    ctx: &BsdfContext,
-    wi: Vec3,
-    pdf_scale: f64,
-    n: usize,
-    significance: f64,
-    seed: u64,
-) -> snee::testing::chi2::Chi2Result {
-    let si = si_with_wi(wi);
-    chi2_sphere(
-        |u1, u2| bsdf.sample(ctx, &si, u1, u2).map(|(bs, _)| bs.wo),
-        |wo| (bsdf.pdf(ctx, &si, wo) as f64 / pdf_scale) as f32,
-        24,
-        48,
-        n,
-        significance,
-        seed,
-    )
-}
-
 fn chi2_bsdf(
     bsdf: &Bsdf,
     ctx: &BsdfContext,
@@ -65,7 +43,7 @@ fn chi2_bsdf(
     significance: f64,
     seed: u64,
 ) -> snee::testing::chi2::Chi2Result {
-    chi2_bsdf_scaled(bsdf, ctx, wi, 1.0, n, significance, seed)
+    BsdfChi2 { samples: n, ..Default::default() }.run(bsdf, ctx, wi, significance, seed)
 }
 
 const ALPHAS: [(f32, f32); 4] = [(0.05, 0.05), (0.2, 0.2), (0.7, 0.7), (0.1, 0.4)];
@@ -87,7 +65,13 @@ fn rough_chi2_family(ggx: bool, visible: bool) {
                 seed += 1;
                 let wi = sph(theta, 33.0 + theta);
                 let scale = if visible && !ggx { beckmann_visible_pdf_scale(au, av, wi) } else { 1.0 };
-                let r = chi2_bsdf_scaled(&bsdf, &BsdfContext::default(), wi, scale, 100_000, significance, seed);
+                let r = BsdfChi2 { pdf_scale: scale, ..Default::default() }.run(
+                    &bsdf,
+                    &BsdfContext::default(),
+                    wi,
+                    significance,
+                    seed,
+                );
                 // The pdf integrates to the probability of a valid sample (< 1: samples whose
                 // direction ends up on the wrong side are discarded, often at grazing incidence
                 // without visible-normal sampling); the missing-mass cell checks that.

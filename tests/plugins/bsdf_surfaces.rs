@@ -4,13 +4,13 @@
 //! - chi-square tests of every sampling routine against its pdf;
 //! - sample weights against eval / pdf.
 
-use crate::{beckmann_visible_pdf_scale, bsdf_desc, close, load_bsdf, mitsuba_json, num, vec3};
+use crate::{beckmann_visible_pdf_scale, bsdf_desc, close, load_bsdf, mitsuba_json, num, vec3, BsdfChi2};
 use snee::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use snee::color::Spectrum;
 use snee::math::{DVec3, Vec2, Vec3};
 use snee::scene::desc::{ObjectDesc, Value};
 use snee::scene::resolver::FileResolver;
-use snee::testing::chi2::{chi2_sphere, sidak};
+use snee::testing::chi2::sidak;
 use snee::testing::{push_alpha, si_with_wi, sph};
 use std::rc::Rc;
 
@@ -132,8 +132,7 @@ fn point_values_match_mitsuba() {
 
 // ---- Chi-square: sampling routines against their pdfs ----
 
-/// Chi-square of `bsdf.sample` against `bsdf.pdf / pdf_scale` for one `wi`; delta and null samples
-/// count as missing mass (they are not part of the density).
+/// [`BsdfChi2`] with delta and null samples as missing mass.
 fn chi2_smooth(
     bsdf: &Bsdf,
     ctx: &BsdfContext,
@@ -170,20 +169,7 @@ fn chi2_smooth_res(
     significance: f64,
     seed: u64,
 ) -> snee::testing::chi2::Chi2Result {
-    let si = si_with_wi(wi);
-    chi2_sphere(
-        |u1, u2| {
-            bsdf.sample(ctx, &si, u1, u2)
-                .filter(|(bs, _)| bs.sampled_type & (flags::DELTA | flags::NULL) == 0)
-                .map(|(bs, _)| bs.wo)
-        },
-        |wo| (bsdf.pdf(ctx, &si, wo) as f64 / pdf_scale) as f32,
-        24,
-        res_phi,
-        100_000,
-        significance,
-        seed,
-    )
+    BsdfChi2 { pdf_scale, res_phi, skip_singular: true, ..Default::default() }.run(bsdf, ctx, wi, significance, seed)
 }
 
 fn rough_conductor(ggx: bool, alpha_u: f32, alpha_v: f32, visible: bool) -> Bsdf {

@@ -108,3 +108,45 @@ pub fn beckmann_visible_pdf_scale(alpha_u: f32, alpha_v: f32, wi: Vec3) -> f64 {
     let g1_exact = 2.0 / (1.0 + erf(a as f32) as f64 + (-a * a).exp() / (a * std::f64::consts::PI.sqrt()));
     g1_fit / g1_exact
 }
+
+/// Chi-square of `bsdf.sample` against `bsdf.pdf / pdf_scale` for one `wi`, on a 24 × `res_phi`
+/// grid with `samples` draws. With `skip_singular`, delta and null samples count as missing mass
+/// (they are not part of the density: the surface BSDFs with a smooth coating or `mask`).
+pub struct BsdfChi2 {
+    pub pdf_scale: f64,
+    pub res_phi: usize,
+    pub samples: usize,
+    pub skip_singular: bool,
+}
+
+impl Default for BsdfChi2 {
+    fn default() -> Self {
+        BsdfChi2 { pdf_scale: 1.0, res_phi: 48, samples: 100_000, skip_singular: false }
+    }
+}
+
+impl BsdfChi2 {
+    pub fn run(
+        &self,
+        bsdf: &Bsdf,
+        ctx: &snee::bsdf::BsdfContext,
+        wi: Vec3,
+        significance: f64,
+        seed: u64,
+    ) -> snee::testing::chi2::Chi2Result {
+        use snee::bsdf::flags;
+        let si = snee::testing::si_with_wi(wi);
+        let singular = if self.skip_singular { flags::DELTA | flags::NULL } else { 0 };
+        snee::testing::chi2::chi2_sphere(
+            |u1, u2| {
+                bsdf.sample(ctx, &si, u1, u2).filter(|(bs, _)| bs.sampled_type & singular == 0).map(|(bs, _)| bs.wo)
+            },
+            |wo| (bsdf.pdf(ctx, &si, wo) as f64 / self.pdf_scale) as f32,
+            24,
+            self.res_phi,
+            self.samples,
+            significance,
+            seed,
+        )
+    }
+}
