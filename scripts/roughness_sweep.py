@@ -3,7 +3,7 @@
 of `volpath` and `volpath_snee` on a thick slab (sigma_t = 1, albedo 0.8, isotropic, 100 mean free
 paths deep) behind a dielectric boundary (n = 1.33) of GGX roughness alpha in {0.2, 0.04, 0.01,
 0.001} or smooth, under a directional light at normal incidence, read by an irradiancemeter on a
-null quad above it (the scene of tests/snee_slab.rs with n = 1.33).
+null quad above it (the scene of tests/transport/snee_slab.rs with n = 1.33).
 
     python3 scripts/roughness_sweep.py [--spp 8192] [--seeds 8] [--threads 2] [--rate R]
 

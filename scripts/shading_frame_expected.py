@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Expected shading frames for tests/shading_frame.rs, computed with Mitsuba 3.
+"""Expected shading frames for tests/plugins/shading_frame.rs, computed with Mitsuba 3.
 
 For each shape (given as Mitsuba XML, rotated so the frame's orientation matters) a few rays are
 traced with Mitsuba's `scalar_rgb` variant; for every hit the script stores the point, geometric

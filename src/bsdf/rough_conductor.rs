@@ -21,7 +21,7 @@
 //!
 //! Anisotropy follows the shading frame's tangent (local x = `alpha_u`), which is Mitsuba's dp/du
 //! (`interaction::shading_frame`): a mesh's uv parametrisation (p1 − p0 without uvs), a sphere's
-//! φ direction in its own rotated frame, a disk's radial direction (`tests/shading_frame.rs`,
+//! φ direction in its own rotated frame, a disk's radial direction (`tests/plugins/shading_frame.rs`,
 //! scene `surfaces_anisotropic`).
 //!
 //! ```xml

@@ -5,7 +5,7 @@
 //! recomputed by angle weighting as Mitsuba's `Mesh::recompute_vertex_normals` does.
 //!
 //! The shading frame's tangent `s` follows dp/du as Mitsuba 3.9.1 computes it (checked against its
-//! hits in `tests/shading_frame.rs`): with uvs, dp/du of the triangle's uv parametrisation, or the
+//! hits in `tests/plugins/shading_frame.rs`): with uvs, dp/du of the triangle's uv parametrisation, or the
 //! first vector of `coordinate_system(face normal before flip_normals)` where the uv triangle is
 //! degenerate; without uvs, uv = (b1, b2) and dp/du = p1 − p0; then Gram–Schmidt against the
 //! shading normal (`interaction::shading_frame`). Face normals and uv tangents do not change per

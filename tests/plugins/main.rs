@@ -1,6 +1,7 @@
 //! Plugins one at a time, against Mitsuba 3.9.1 and against their own pdfs: BSDFs (`bsdf`,
 //! `bsdf_surfaces`), emitters (`emitters`), shapes as area lights (`shapes`), textures and image
-//! files (`textures`, `bitmap_formats`), sensors and films (`sensor`, `film`).
+//! files (`textures`, `bitmap_formats`), sensors and films (`sensor`, `film`), shading frames of
+//! ray hits (`shading_frame`).
 //!
 //! Mitsuba's numbers are JSON files in `tests/data/`, each written by a script in `scripts/`
 //! (named in the test module that reads it), rounded to 9 or 10 significant digits (round-trip
@@ -12,8 +13,12 @@ mod bsdf_surfaces;
 mod emitters;
 mod film;
 mod sensor;
+mod shading_frame;
 mod shapes;
 mod textures;
+
+#[path = "../common/mod.rs"]
+mod common;
 
 use serde_json::Value as Json;
 use snee::bsdf::Bsdf;

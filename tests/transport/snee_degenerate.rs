@@ -2,7 +2,7 @@
 //! σt with a zero channel), behind smooth and rough boundaries, under directional, constant and
 //! area light; and the distance-sampling mixture against its density (1-D histogram, chi-square).
 
-mod common;
+use crate::common;
 
 use snee::integrator::snee::distance::DistanceSampler;
 use snee::math::Vec3;

@@ -18,7 +18,7 @@
 //! (rectangle) and 4.5 % (sphere), too weak a test; its count was raised to 12 × 1024 spp and
 //! `complete`'s to 12 × 256 before the second run.
 
-mod common;
+use crate::common;
 
 use common::{render_batches, scene, welch_compare};
 

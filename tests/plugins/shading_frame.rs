@@ -4,7 +4,7 @@
 //! (`alpha_u` along `s`); Mitsuba takes it from dp/du. Expected values: tests/data/shading_frames.json,
 //! written by scripts/shading_frame_expected.py with Mitsuba's `scalar_rgb`.
 
-mod common;
+use crate::common;
 
 use snee::math::{Ray, Vec3};
 

@@ -16,7 +16,7 @@
 //! a = 0.95, g = 0.5 (0.32 %); doubling the samples gave 0.27 % there; the bound was then set to
 //! the value the Z-test argument gives.
 
-mod common;
+use crate::common;
 
 use snee::render::{render, RenderOptions};
 use std::sync::atomic::AtomicBool;

@@ -4,7 +4,7 @@
 //!   independent batches, Šidák-corrected at 1 %);
 //! - with `transport = snee`, the `snee`, `forward` and `mis` modes agree with each other.
 
-mod common;
+use crate::common;
 
 use common::{render_batches, scene, welch_compare};
 

@@ -18,7 +18,7 @@
 //! hero-channel weights gave it an 8.5 % standard error, too weak a test; the medium was made grey
 //! and the count raised to 12 × 64 spp (image-mean standard errors ~0.25 %).
 
-mod common;
+use crate::common;
 
 use common::{render_batches, scene, welch_compare};
 use snee::render::{render, RenderOptions};

@@ -14,7 +14,7 @@
 //! medium vertex is an internal reflection, which neither SNEE nor forward tracing can produce
 //! under a delta light behind a smooth interface; they are not tested here.
 
-mod common;
+use crate::common;
 
 /// The slab of `common::slab_xml` behind a smooth n = 1 dielectric (a delta interface).
 fn slab(integrator: &str, albedo: f64, g: f64) -> String {

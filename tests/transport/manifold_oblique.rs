@@ -13,7 +13,7 @@
 //! from inside (1 beyond the critical angle). Adding-doubling cannot check this: iadpython does not
 //! implement oblique incidence. Sample counts fixed before the first run: 16 batches × 16384.
 
-mod common;
+use crate::common;
 
 use snee::render::{render, RenderOptions};
 use std::f64::consts::PI;

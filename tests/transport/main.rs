@@ -1,0 +1,16 @@
+//! Light transport through refractive boundaries, one test binary: subdivision NEE (`snee_*`:
+//! slab against adding-doubling, agreement with `volpath`, degenerate inputs) and manifold NEE
+//! (`manifold_*`: slabs against adding-doubling, oblique beams, options, agreement with `volpath`
+//! for environment and finite lights).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod manifold_finite;
+mod manifold_oblique;
+mod manifold_options;
+mod manifold_slab;
+mod manifold_unbiased;
+mod snee_degenerate;
+mod snee_slab;
+mod snee_unbiased;
