@@ -5,8 +5,7 @@
 //! `integrator/mod.rs`; parsing is in the plugin files (`integrator/mod.rs`, `moment.rs`,
 //! `volpath_snee.rs`).
 
-use super::manifold::Connection;
-use super::snee::options::{Snee, SneeOptions};
+use super::snee::options::{Connection, Snee, SneeOptions};
 use std::ops::{Deref, DerefMut};
 
 /// The XML integrator type.

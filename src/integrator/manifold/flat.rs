@@ -15,49 +15,8 @@ use crate::math::{Frame, Vec3};
 use crate::scene::world::Scene;
 use crate::shape::Geometry;
 
-/// Most distinct planes enumerated per connection (a cube has 6); more: the medium is not handled.
-pub const MAX_PLANES: usize = 64;
-/// Two unit normals belong to the same plane orientation when their dot product exceeds this.
-pub const SAME_NORMAL: f32 = 1.0 - 1e-5;
-
-/// One orientation of the boundary: outward unit normal and `η = η_int / η_ext` of its dielectric.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plane {
-    pub n: Vec3,
-    pub eta: f32,
-}
-
-/// One supporting plane of the boundary: an orientation and its offset, the points `x` with
-/// `plane.n · x = offset` (lights at a finite distance need it: the refraction point depends on it).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Support {
-    pub plane: Plane,
-    pub offset: f32,
-}
-
-/// The flat boundary of one medium: its distinct plane orientations, and its distinct supporting
-/// planes (empty when there are more than [`MAX_PLANES`]: then lights at a finite distance are not
-/// handled, directional lights and environments still are).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct FlatBoundary {
-    pub planes: Vec<Plane>,
-    pub supports: Vec<Support>,
-}
-
-impl FlatBoundary {
-    /// The supporting plane through the boundary point `p` with normal `n` and index `eta`.
-    pub fn support_at(&self, p: Vec3, n: Vec3, eta: f32) -> Option<&Support> {
-        self.supports
-            .iter()
-            .find(|s| s.plane.eta == eta && s.plane.n.dot(n) > SAME_NORMAL && same_offset(s.plane.n.dot(p), s.offset))
-    }
-}
-
-/// Two plane offsets (distances along the same normal) are the same plane.
-#[inline]
-fn same_offset(a: f32, b: f32) -> bool {
-    (a - b).abs() <= 1e-4 * (1.0 + a.abs().max(b.abs()))
-}
+use super::planes::same_offset;
+pub use super::planes::{FlatBoundary, Plane, Support, MAX_PLANES, SAME_NORMAL};
 
 /// Per medium of `scene`: its flat boundary, or `None` where the manifold connection does not
 /// apply (the scene has no emitter, the medium does not sample emitters, is not

@@ -31,6 +31,7 @@ pub mod finite;
 pub mod flat;
 pub mod mis;
 pub mod pdf;
+pub mod planes;
 pub mod stage;
 pub mod track;
 
@@ -40,31 +41,13 @@ use super::snee::{self, LightSample, Snee, SneeOptions, SneeSuffix, SneeTechniqu
 use super::stats::LocalStats;
 use super::volpath::Cx;
 use crate::color::Spectrum;
+pub use crate::integrator::snee::options::Connection;
 use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
 use crate::math::{Ray, Vec2, Vec3};
 use crate::scene::world::Scene;
 use flat::{on_plane, refract_into, FlatBoundary, Plane, Refraction};
 pub use stage::ManifoldStage;
 pub use track::Tracker;
-
-/// Which estimator `volpath_snee` runs (`connection` parameter).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Connection {
-    /// The paper's: SNEE and forward tracing only.
-    #[default]
-    Paper,
-    /// Also the manifold connection at every medium vertex (where it applies), MIS with SNEE.
-    Complete,
-}
-
-impl Connection {
-    pub fn name(self) -> &'static str {
-        match self {
-            Connection::Paper => "paper",
-            Connection::Complete => "complete",
-        }
-    }
-}
 
 /// A medium vertex the connection starts from (`x_j` in docs/manifold.md).
 #[derive(Clone, Copy, Debug)]

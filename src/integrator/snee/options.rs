@@ -57,5 +57,24 @@ pub struct Snee {
     pub has_non_delta_emitter: bool,
     /// Per medium: its flat smooth boundary where the manifold connection applies
     /// (`connection = complete`, `manifold::flat::flat_boundaries`; empty with `paper`).
-    pub flat: Vec<Option<crate::integrator::manifold::flat::FlatBoundary>>,
+    pub flat: Vec<Option<crate::integrator::manifold::planes::FlatBoundary>>,
+}
+
+/// Which estimator `volpath_snee` runs (`connection` parameter).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Connection {
+    /// The paper's: SNEE and forward tracing only.
+    #[default]
+    Paper,
+    /// Also the manifold connection at every medium vertex (where it applies), MIS with SNEE.
+    Complete,
+}
+
+impl Connection {
+    pub fn name(self) -> &'static str {
+        match self {
+            Connection::Paper => "paper",
+            Connection::Complete => "complete",
+        }
+    }
 }

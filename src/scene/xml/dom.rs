@@ -235,6 +235,29 @@ fn normalize_whitespace(s: &str) -> String {
     s.replace(['\t', '\n', '\r'], " ")
 }
 
+/// Check that the attributes are among `allowed` and that `required` are present (Mitsuba's
+/// `check_attributes`: unexpected attributes are reported first).
+pub fn check_attrs(tag: &str, pos: &SrcPos, attrs: &[Attr], allowed: &[&str], required: &[&str]) -> Result<()> {
+    for a in attrs {
+        if !allowed.contains(&a.name.as_str()) {
+            return Err(Error::at(
+                &a.pos,
+                format!("unexpected attribute \"{}\" in <{tag}> (allowed: {})", a.name, allowed.join(", ")),
+            ));
+        }
+    }
+    for r in required {
+        if find(attrs, r).is_none() {
+            return Err(Error::at(pos, format!("missing required attribute \"{r}\" in <{tag}>")));
+        }
+    }
+    Ok(())
+}
+
+pub fn find<'a>(attrs: &'a [Attr], name: &str) -> Option<&'a Attr> {
+    attrs.iter().find(|a| a.name == name)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,7 +2,7 @@
 //! nodes, following Mitsuba 3.9's `parse_xml_node` tag by tag. References stay unresolved here
 //! (a `<ref>` may name an object defined later); [`super::build`] resolves them.
 
-use super::dom::{self, Attr, Element};
+use super::dom::{self, check_attrs, find, Attr, Element};
 use super::number::{parse_bool, parse_float, parse_int, parse_version, tokens, Version};
 use super::params::Params;
 use super::spectrum::{parse_spectrum, spectrum_list_to_srgb, SpectrumSpec};
@@ -101,29 +101,6 @@ pub struct Parser {
     include_stack: Vec<PathBuf>,
     /// Current element nesting, counted across included files.
     depth: usize,
-}
-
-/// Check that the attributes are among `allowed` and that `required` are present (Mitsuba's
-/// `check_attributes`: unexpected attributes are reported first).
-pub fn check_attrs(tag: &str, pos: &SrcPos, attrs: &[Attr], allowed: &[&str], required: &[&str]) -> Result<()> {
-    for a in attrs {
-        if !allowed.contains(&a.name.as_str()) {
-            return Err(Error::at(
-                &a.pos,
-                format!("unexpected attribute \"{}\" in <{tag}> (allowed: {})", a.name, allowed.join(", ")),
-            ));
-        }
-    }
-    for r in required {
-        if find(attrs, r).is_none() {
-            return Err(Error::at(pos, format!("missing required attribute \"{r}\" in <{tag}>")));
-        }
-    }
-    Ok(())
-}
-
-pub fn find<'a>(attrs: &'a [Attr], name: &str) -> Option<&'a Attr> {
-    attrs.iter().find(|a| a.name == name)
 }
 
 /// The value of an attribute that [`check_attrs`] has made sure exists.

@@ -14,9 +14,8 @@
 //! scales), `matrix` drops the bottom (projective) row, and `lookat` without `up` (or with a zero
 //! `up`) picks one from the viewing direction.
 
-use super::dom::Attr;
+use super::dom::{check_attrs, find, Attr};
 use super::number::{parse_float, tokens};
-use super::parser::{check_attrs, find};
 use crate::scene::error::{Error, Result, SrcPos};
 use glam::{DMat4, DVec3, DVec4};
 

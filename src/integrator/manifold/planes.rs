@@ -1,0 +1,49 @@
+//! The planes of a flat boundary as plain data (the scene's `volpath_snee` tables store them, so
+//! this file imports nothing of the scene): orientations, supporting planes, and the lookup of the
+//! plane through a boundary point. Finding them in a scene is `flat.rs`.
+
+use crate::math::Vec3;
+
+/// Most distinct planes enumerated per connection (a cube has 6); more: the medium is not handled.
+pub const MAX_PLANES: usize = 64;
+/// Two unit normals belong to the same plane orientation when their dot product exceeds this.
+pub const SAME_NORMAL: f32 = 1.0 - 1e-5;
+
+/// One orientation of the boundary: outward unit normal and `η = η_int / η_ext` of its dielectric.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    pub n: Vec3,
+    pub eta: f32,
+}
+
+/// One supporting plane of the boundary: an orientation and its offset, the points `x` with
+/// `plane.n · x = offset` (lights at a finite distance need it: the refraction point depends on it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Support {
+    pub plane: Plane,
+    pub offset: f32,
+}
+
+/// The flat boundary of one medium: its distinct plane orientations, and its distinct supporting
+/// planes (empty when there are more than [`MAX_PLANES`]: then lights at a finite distance are not
+/// handled, directional lights and environments still are).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FlatBoundary {
+    pub planes: Vec<Plane>,
+    pub supports: Vec<Support>,
+}
+
+impl FlatBoundary {
+    /// The supporting plane through the boundary point `p` with normal `n` and index `eta`.
+    pub fn support_at(&self, p: Vec3, n: Vec3, eta: f32) -> Option<&Support> {
+        self.supports
+            .iter()
+            .find(|s| s.plane.eta == eta && s.plane.n.dot(n) > SAME_NORMAL && same_offset(s.plane.n.dot(p), s.offset))
+    }
+}
+
+/// Two plane offsets (distances along the same normal) are the same plane.
+#[inline]
+pub(super) fn same_offset(a: f32, b: f32) -> bool {
+    (a - b).abs() <= 1e-4 * (1.0 + a.abs().max(b.abs()))
+}
