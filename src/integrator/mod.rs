@@ -18,6 +18,7 @@
 //! | `hide_emitters` | boolean | false   | emitters seen directly are black                       |
 
 pub mod classes;
+pub mod cx;
 pub mod desc;
 pub mod enclosure;
 pub mod manifold;

@@ -22,8 +22,9 @@
 //! ([`ManifoldStage`], `manifold/stage.rs`).
 
 use super::classes::{End, NoClasses, Tally};
+use super::cx::ForwardWeight;
+pub use super::cx::{Cx, EmitterHit, Scatter, Stages};
 use super::manifold::ManifoldStage;
-use super::snee::stage::Scatter;
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
 use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, PathSetup, RefPoint, MAX_SEGMENTS};
@@ -162,36 +163,27 @@ pub fn li_tally<T: Tally>(
     trace(scene, sampler, ray, medium, stats, weight, snee.map(SneeStage::new), tally)
 }
 
-/// An emitter the path's ray (along `ray_d`) hit: its radiance, the direction sample from the
-/// last scattering vertex `from` (for MIS densities), the point SNEE's light record uses, and
-/// whether it counts at full weight (`count_direct`: seen directly or after a specular chain).
-#[derive(Clone, Copy, Debug)]
-pub struct EmitterHit {
-    pub le: Spectrum,
-    pub ds: DirectionSample,
-    pub from: Vec3,
-    pub light_p: Vec3,
-    pub ray_d: Vec3,
-    pub count_direct: bool,
+/// volpath_snee's connection stages as forward tracing's MIS sees them ([`ForwardWeight`]).
+struct ConnectionStages<'s, 'a> {
+    snee: &'s SneeStage<'a>,
+    manifold: Option<&'s ManifoldStage<'a>>,
 }
 
-/// The connection stages of `volpath_snee` that weigh forward contributions (none elsewhere).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Stages<'s, 'a> {
-    pub snee: Option<&'s SneeStage<'a>>,
-    pub manifold: Option<&'s ManifoldStage<'a>>,
-}
+impl ForwardWeight for ConnectionStages<'_, '_> {
+    #[inline]
+    fn emitter_hit_weight(&self, cx: &mut Cx, hit: &EmitterHit, p_light: &dyn Fn() -> f32, w: f32) -> f32 {
+        let (scene, channel, stats) = (cx.scene, cx.channel, &mut *cx.stats);
+        let light = || LightSample::hit(hit.ray_d, hit.light_p, hit.ds.dist, p_light());
+        let w = self.snee.weight(scene, ForwardTechnique::Bsdf, light, w, channel, stats);
+        // An escape right after leaving x_j's medium is shared with the manifold connection.
+        self.manifold.and_then(|m| m.weight(scene, self.snee, hit.ray_d, channel, stats)).unwrap_or(w)
+    }
 
-/// What an estimator's call needs besides its own arguments: the scene, the hero channel, the
-/// medium the path is in, the path's sample stream, the statistics, and the connection stages
-/// that weigh forward contributions at surfaces.
-pub struct Cx<'a, 's, 'b> {
-    pub scene: &'a Scene,
-    pub channel: usize,
-    pub medium: Option<u32>,
-    pub sampler: &'a mut Sampler,
-    pub stats: &'a mut LocalStats,
-    pub stages: Stages<'s, 'b>,
+    #[inline]
+    fn emitter_sampling_weight(&self, cx: &mut Cx, ds: &DirectionSample, w: f32) -> f32 {
+        let (scene, channel, stats) = (cx.scene, cx.channel, &mut *cx.stats);
+        self.snee.weight(scene, ForwardTechnique::Nee, || LightSample::sampled(ds), w, channel, stats)
+    }
 }
 
 /// What the path loop asks of its estimator at each event (`volpath`: [`Beta`]; `volpathmis`: its
@@ -298,7 +290,7 @@ impl PathWeight for Beta {
 
     #[inline]
     fn emitter_hit(&mut self, cx: &mut Cx, hit: &EmitterHit) -> Spectrum {
-        let (scene, channel, stats) = (cx.scene, cx.channel, &mut *cx.stats);
+        let scene = cx.scene;
         // An emitter with zero radiance toward us is no hit (nor a suffix for SNEE to weigh).
         if hit.le == Spectrum::ZERO {
             return Spectrum::ZERO;
@@ -307,13 +299,8 @@ impl PathWeight for Beta {
         let p_light = std::cell::OnceCell::new();
         let p_light = || *p_light.get_or_init(|| scene.pdf_emitter_direction(hit.from, &hit.ds));
         let mut w = if hit.count_direct { 1.0 } else { mis_weight(self.last_scatter_pdf, p_light()) };
-        if let Some(snee) = cx.stages.snee {
-            let light = || LightSample::hit(hit.ray_d, hit.light_p, hit.ds.dist, p_light());
-            w = snee.weight(scene, ForwardTechnique::Bsdf, light, w, channel, stats);
-            // An escape right after leaving x_j's medium is shared with the manifold connection.
-            if let Some(wm) = cx.stages.manifold.and_then(|m| m.weight(scene, snee, hit.ray_d, channel, stats)) {
-                w = wm;
-            }
+        if let Some(stages) = cx.stages.forward {
+            w = stages.emitter_hit_weight(cx, hit, &p_light, w);
         }
         self.beta * hit.le * w
     }
@@ -331,8 +318,8 @@ impl PathWeight for Beta {
         }
         let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&BsdfContext::default(), s, s.to_local(ds.d));
         let mut w = mis_weight(ds.pdf, if ds.delta { 0.0 } else { bsdf_pdf });
-        if let Some(snee) = cx.stages.snee {
-            w = snee.weight(scene, ForwardTechnique::Nee, || LightSample::sampled(&ds), w, channel, stats);
+        if let Some(stages) = cx.stages.forward {
+            w = stages.emitter_sampling_weight(cx, &ds, w);
         }
         (self.beta * bsdf_val * w * emitted, ds.d)
     }
@@ -502,7 +489,8 @@ pub fn trace<W: PathWeight, T: Tally>(
             }),
             _ => None,
         };
-        let stages = Stages { snee: snee.as_ref(), manifold: manifold.as_ref() };
+        let connection = snee.as_ref().map(|snee| ConnectionStages { snee, manifold: manifold.as_ref() });
+        let stages = Stages { forward: connection.as_ref().map(|c| c as &dyn ForwardWeight) };
         if let (false, Some(hit)) = (hide, hit) {
             let c = weight.emitter_hit(&mut Cx { scene, channel, medium, sampler, stats, stages }, &hit);
             result += c;

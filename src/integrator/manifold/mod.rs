@@ -35,11 +35,11 @@ pub mod planes;
 pub mod stage;
 pub mod track;
 
+use super::cx::Cx;
+use super::cx::Scatter;
 use super::desc::Integrator;
-use super::snee::stage::Scatter;
 use super::snee::{self, LightSample, Snee, SneeOptions, SneeSuffix, SneeTechnique, SneeTransport, SneeVertex};
 use super::stats::LocalStats;
-use super::volpath::Cx;
 use crate::color::Spectrum;
 pub use crate::integrator::snee::options::Connection;
 use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};

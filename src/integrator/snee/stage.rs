@@ -15,26 +15,13 @@ use super::rate::snee_vertex;
 use super::{encloses, passable, LightSample, SneeSuffix, SneeVertex};
 use crate::bsdf::{flags, BsdfSample};
 use crate::color::Spectrum;
+use crate::integrator::cx::Cx;
+pub use crate::integrator::cx::Scatter;
 use crate::integrator::stats::LocalStats;
 use crate::integrator::technique::Technique;
-use crate::integrator::volpath::Cx;
 use crate::interaction::SurfaceInteraction;
 use crate::math::Vec3;
 use crate::scene::world::Scene;
-
-/// A real scatter of the path as the stages at medium vertices see it (SNEE's and the manifold
-/// connection's `at_scatter`).
-#[derive(Clone, Copy, Debug)]
-pub struct Scatter {
-    pub medium: u32,
-    pub p: Vec3,
-    /// Direction back to the previous vertex (the phase function's `wi`).
-    pub wi: Vec3,
-    pub depth: u32,
-    pub max_depth: u32,
-    /// The throughput at `p`, including `sigma_s`.
-    pub beta: Spectrum,
-}
 
 /// SNEE's state along one path.
 #[derive(Clone, Debug)]
