@@ -169,6 +169,20 @@ pub fn slab_scene(integrator: &str, direction: &str, albedo: f64, g: f64, bounda
     )
 }
 
+/// A smooth glass boundary (`dielectric`, n = 1.5) and an index-matched one (int = ext = 1: no
+/// refraction, no Fresnel), the two boundaries of the manifold tests.
+pub const GLASS: &str = r#"<bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf>"#;
+pub const MATCHED: &str =
+    r#"<bsdf type="dielectric"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf>"#;
+
+/// `volpath_snee` with `connection = complete` (`snee = mis` and `snee = forward`) against a
+/// `volpath` reference: no rejected sample, and both agree at family-wise level 1 % (Šidák over 2).
+pub fn assert_complete_agrees(volpath: &Batches, mis: &Batches, fwd: &Batches) {
+    assert_eq!(mis.rejected + fwd.rejected, 0);
+    let report = agree_with_reference(("volpath", volpath), &[("complete mis", mis), ("complete forward", fwd)], 0.01);
+    assert!(report.is_empty(), "{report}");
+}
+
 /// Compare several estimators with one reference (Welch, Šidák over the comparisons at family-wise
 /// `alpha`), print every image mean and relative standard error, and return the failures' report
 /// (empty when all agree).

@@ -20,16 +20,13 @@
 
 use crate::common;
 
-use common::{render_batches, scene, welch_compare};
+use common::{render_batches, scene, welch_compare, GLASS, MATCHED};
 
 fn cube(integrator: &str, extra: &str, bsdf: &str, emitter: &str) -> String {
     let props = format!(r#"<boolean name="hide_emitters" value="true"/>{extra}"#);
     common::medium_cube(integrator, &props, bsdf, emitter)
 }
 
-const GLASS: &str = r#"<bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf>"#;
-const MATCHED: &str =
-    r#"<bsdf type="dielectric"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf>"#;
 const COMPLETE: &str = r#"<string name="connection" value="complete"/>"#;
 const COMPLETE_FORWARD: &str = r#"<string name="connection" value="complete"/><string name="snee" value="forward"/>"#;
 
@@ -39,13 +36,7 @@ fn agrees_with_volpath(emitter: &str, seed: u64) {
     let mis = render_batches(&scene(&cube("volpath_snee", COMPLETE, GLASS, emitter), &[]), 12, 256, 8, seed + 100);
     let fwd =
         render_batches(&scene(&cube("volpath_snee", COMPLETE_FORWARD, GLASS, emitter), &[]), 12, 256, 8, seed + 200);
-    assert_eq!(mis.rejected + fwd.rejected, 0);
-    let report = common::agree_with_reference(
-        ("volpath", &volpath),
-        &[("complete mis", &mis), ("complete forward", &fwd)],
-        0.01,
-    );
-    assert!(report.is_empty(), "{report}");
+    common::assert_complete_agrees(&volpath, &mis, &fwd);
 }
 
 #[test]

@@ -20,7 +20,7 @@
 
 use crate::common;
 
-use common::{render_batches, scene, welch_compare};
+use common::{render_batches, scene, welch_compare, GLASS, MATCHED};
 use snee::render::{render, RenderOptions};
 use std::sync::atomic::AtomicBool;
 
@@ -29,8 +29,6 @@ fn cube(integrator: &str, bsdf: &str, emitter: &str) -> String {
 }
 
 const DIRECTIONAL: &str = r#"<emitter type="directional"><vector name="direction" value="0.5, 0.4, -0.75"/><rgb name="irradiance" value="3, 3, 3"/></emitter>"#;
-const MATCHED: &str =
-    r#"<bsdf type="dielectric"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf>"#;
 
 #[test]
 fn complete_agrees_with_volpath_through_null_boundary() {
@@ -58,7 +56,7 @@ fn complete_agrees_with_volpath_through_null_boundary() {
 #[test]
 fn complete_agrees_with_volpath_under_envmap() {
     let env = r#"<emitter type="envmap"><string name="filename" value="textures/sky.exr"/></emitter>"#;
-    let glass = r#"<bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf>"#;
+    let glass = GLASS;
     // The environment seen directly is hidden: the image is the cube alone.
     let with = |integrator: &str, extra: &str| {
         cube(integrator, glass, env).replace(
@@ -71,22 +69,15 @@ fn complete_agrees_with_volpath_under_envmap() {
     let volpath = render_batches(&scene(&with("volpath", ""), &[]), 12, 128, 8, 4000);
     let mis = render_batches(&scene(&complete(""), &[]), 12, 128, 8, 5000);
     let fwd = render_batches(&scene(&complete(r#"<string name="snee" value="forward"/>"#), &[]), 12, 128, 8, 6000);
-    assert_eq!(mis.rejected + fwd.rejected, 0);
     assert!(mis.stats.len() > 1);
-    // Two comparisons against the same reference: Šidák over 2.
-    let report = common::agree_with_reference(
-        ("volpath", &volpath),
-        &[("complete mis", &mis), ("complete forward", &fwd)],
-        0.01,
-    );
-    assert!(report.is_empty(), "{report}");
+    common::assert_complete_agrees(&volpath, &mis, &fwd);
 }
 
 #[test]
 fn complete_is_paper_on_curved_boundary() {
     let area = r#"<shape type="sphere"><point name="center" x="-2" y="1" z="3"/><float name="radius" value="0.5"/>
         <emitter type="area"><rgb name="radiance" value="20, 20, 20"/></emitter></shape>"#;
-    let glass = r#"<bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf>"#;
+    let glass = GLASS;
     let sphere =
         |integrator: &str| cube(integrator, glass, area).replace(r#"<shape type="cube">"#, r#"<shape type="sphere">"#);
     let paper = scene(&sphere("volpath_snee"), &[]);
