@@ -89,6 +89,7 @@ import json
 import math
 import os
 import re
+import resource
 import subprocess
 import sys
 import time
@@ -109,17 +110,29 @@ LABEL = {"envmap": "envmap", "sphere": "sphere 0.006 sr", "directional": "direct
          "ggx020": "GGX 0.2", "ggx004": "GGX 0.04", "smooth": "smooth",
          "st02": "sigma_t 2/m", "st34": "sigma_t 34/m"}
 MODES = {
-    "standard": {"fig3_spp": 32, "run_time": 0.5, "runs": 8, "ref_factor": 100, "ref_parts": 4,
-                 "omegas": [0.006, 0.003, 0.0015], "firefly_scale": 6, "threads": 2, "boot": 2000},
-    "paper": {"fig3_spp": 500, "run_time": 30.0, "runs": 8, "ref_factor": 100, "ref_parts": 10,
-              "omegas": [0.006, 0.003, 0.0015], "firefly_scale": 16, "threads": 1, "boot": 4000},
+    "standard": {"fig3_spp": 32, "run_time": 1.0, "runs": 16, "probe": 0.25, "ref_factor": 100, "ref_parts": 8,
+                 "ref_scale": 2, "ds_factor": 2, "d_factor": 25, "omegas": [0.006, 0.003, 0.0015],
+                 "firefly_scale": 6, "threads": 2, "boot": 2000},
+    "paper": {"fig3_spp": 500, "run_time": 30.0, "runs": 8, "probe": 0.25, "ref_factor": 100, "ref_parts": 10,
+              "ref_scale": 2, "ds_factor": 2, "d_factor": 25, "omegas": [0.006, 0.003, 0.0015],
+              "firefly_scale": 16, "threads": 1, "boot": 4000},
     # --smoke: a check that the pipeline runs (seconds per configuration); its numbers mean nothing.
-    "smoke": {"fig3_spp": 4, "run_time": 0.1, "runs": 3, "ref_factor": 10, "ref_parts": 2,
-              "omegas": [0.006, 0.003, 0.0015], "firefly_scale": 2, "threads": 2, "boot": 200},
+    "smoke": {"fig3_spp": 4, "run_time": 0.1, "runs": 3, "probe": 0.5, "ref_factor": 4, "ref_parts": 2,
+              "ref_scale": 2, "ds_factor": 1, "d_factor": 2, "omegas": [0.006, 0.003, 0.0015],
+              "firefly_scale": 2, "threads": 2, "boot": 200},
 }
+# The references' spp come from a CPU-time rate measured on the (possibly loaded) machine that renders
+# them; an idle machine's runs get more spp per second (no hyper-thread or cache contention): the
+# planned spp are this factor above the measured rate's prediction.
+REF_HEADROOM = 1.5
 SPHERE_DISTANCE = 1000.0  # m: the irradiance varies by +-0.1 % over the 1 m statue
 FIREFLY_FACTOR = 100.0
 ALPHA = 0.01  # family-wise level of the bias tests
+CLASS_ORDER = ["surface", "single", "snee_support", "snee_hidden", "surface_before_last", "internal_reflection",
+               "other"]  # docs/classes.md
+EQUAL_WITHIN = 0.1  # an undecided ratio whose interval lies in [1/1.1, 1.1] reads "equal within +-10 %"
+RUN_COUNTS = (1, 2, 4, 8, 16)  # relMSE of the average of the first k runs (JSON relmse_k, the chart)
+CLASS_SUM_TOL = 1e-5  # the classes' sum against the image: max |difference| / max |image| (float32 EXR)
 LUM = np.array([0.212671, 0.715160, 0.072169])
 MI_NOT_INSTALLED = 3
 RENDERED = [0]  # renders this process ran (a re-analysis of cached renders keeps the first run's times)
@@ -130,11 +143,13 @@ VARIANTS = {
     "fig3_forward": ("volpath_snee", '<string name="snee" value="forward"/><string name="transport" value="snee"/>'),
     "fig3_snee": ("volpath_snee", '<string name="snee" value="mis"/><string name="transport" value="snee"/>'
                   '<float name="snee_rate" value="1"/>'),
+    "complete": ("volpath_snee", '<string name="connection" value="complete"/>'),
 }
 METHODS = [  # key, label, plot style
     ("volpath", "snee volpath", dict(color="C0", marker="o")),
     ("snee", "snee volpath_snee", dict(color="C1", marker="s")),
     ("mitsuba", "Mitsuba volpath", dict(color="C2", marker="^")),
+    ("complete", "snee volpath_snee connection=complete", dict(color="C3", marker="D")),
 ]
 
 
@@ -336,7 +351,8 @@ def class_shares(ch, n, denom):
     img = rgb_of(ch)
     total = sum(rgb_of(ch, c + ".") for c in names)
     return {"V": v_total, "sum_max_rel_diff": float(np.max(np.abs(total - img)) / max(np.max(np.abs(img)), 1e-30)),
-            "share": {c: safe_div(float(np.mean(moment_var(ch, n, c + ".") / denom)), v_total) for c in names}}
+            "share": {c: safe_div(float(np.mean(moment_var(ch, n, c + ".") / denom)), v_total) for c in names},
+            "energy": {c: safe_div(float(rgb_of(ch, c + ".").sum()), float(img.sum())) for c in names}}
 
 
 def safe_div(a, b):
@@ -352,29 +368,91 @@ def firefly_rate(img, ref_mean_lum):
 
 # ----------------------------------------------------------------------------- one configuration
 
-def reference(args, P, work, name):
+def film_size(config):
+    """(width, height) of a configuration's film (its <default> values)."""
+    text = scene_text(config)
+    w, h = (int(re.search(rf'<default name="{k}" value="(\d+)"/>', text).group(1)) for k in ("width", "height"))
+    return w, h
+
+
+def half_size(config, scale):
+    w, h = film_size(config)
+    assert w % scale == 0 and h % scale == 0, config
+    return ["-D", f"width={w // scale}", "-D", f"height={h // scale}"]
+
+
+def cpu_rate(args, refs, xml, tag):
+    """Samples per CPU-second of one thread rendering XML at the run's resolution (cached in
+    REFS/plan/TAG.json): the CPU times of two 1-thread renders (2 and 18 spp) differ by 16 spp, so
+    scene loading cancels. Measured under any load (CPU time, not wall time)."""
+    path = os.path.join(refs, "plan", tag + ".json")
+    if os.path.exists(path):
+        with open(path) as fh:
+            return json.load(fh)["samples_per_cpu_second"]
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    out = os.path.join(refs, "plan", tag + ".probe.exr")
+
+    def cpu(spp):
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run([SNEE, "render", xml, "-o", out, "--spp", str(spp), "--threads", "1", "-q"], check=True)
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return (r1.ru_utime + r1.ru_stime) - (r0.ru_utime + r0.ru_stime)
+    w, h = film_size(tag.split(".")[0])
+    seconds = max(cpu(18) - cpu(2), 1e-3)
+    rate = 16 * w * h / seconds
+    os.remove(out)
+    common.write_json_atomic(path, {"samples_per_cpu_second": rate, "cpu_seconds_16spp": seconds})
+    return rate
+
+
+def planned_spp(args, P, refs, name, xml, tag, factor):
+    """Reference spp per pixel (at 1/ref_scale resolution), a multiple of ref_parts: factor x the
+    spp a run of XML would get on an idle machine (args.threads threads x run_time x the 1-thread
+    CPU rate, times REF_HEADROOM: idle cores run faster than the loaded ones the rate was
+    measured on)."""
+    w, h = film_size(name)
+    run_spp = args.threads * P["run_time"] * cpu_rate(args, refs, xml, tag) / (w * h) * REF_HEADROOM
+    per_part = max(1, math.ceil(factor * run_spp / P["ref_parts"]))
+    return per_part, run_spp
+
+
+def render_parts(args, P, refs, name, xml, tag, per_part, seed0, need_spp=0):
+    """ref_parts renders of per_part spp at 1/ref_scale resolution with --moment (seeds seed0 + k),
+    plus as many more as reach need_spp in total (a reference that an idle machine's faster runs
+    outgrew is topped up, not replaced)."""
+    count = max(P["ref_parts"], math.ceil(need_spp / per_part))
+    return [snee_render(args, refs, xml, f"{tag}.{per_part}spp.{k}", seed=seed0 + k, spp=per_part,
+                        extra=["--moment", *half_size(name, P["ref_scale"])]) for k in range(count)]
+
+
+def pooled(parts):
+    """spp-weighted mean, per-sample variance (ddof 1) and total spp of --moment parts."""
+    n = sum(st["spp"] for _, st in parts)
+    mean = sum(rgb_of(ch) * st["spp"] for ch, st in parts) / n
+    m2 = sum(rgb_of(ch, "m2.") * st["spp"] for ch, st in parts) / n
+    return mean, np.maximum(m2 - mean * mean, 0) * n / max(n - 1, 1), n
+
+
+def reference(args, P, refs, name, need_spp=0):
+    """The configuration's reference (see the module docstring), rendered into (or read from) REFS.
+    Images (image, d) are at 1/ref_scale resolution; need_spp: the spp per pixel the volpath
+    reference must reach (ref_factor x the volpath runs' spp), 0 before the runs are known."""
     light, boundary, _ = name.split("_")
-    parts, out = [], {}
-    budget = P["ref_factor"] * P["run_time"]
+    out = {"scale": P["ref_scale"]}
     if light == "directional" and boundary == "smooth":
         out["kind"] = (f"volpath, sphere lights of {', '.join(f'{o:g}' for o in P['omegas'])} sr at equal irradiance, "
                        "image mean extrapolated to 0 sr")
         pts = []
         for omega in P["omegas"]:
-            xml = variant_xml(work, name, "volpath", omega)
-            est_parts = []
-            for k in range(P["ref_parts"]):
-                ch, st = snee_render(args, work, xml, f"{name}.ref.omega{omega:g}.{k}", seed=5000 + k, extra=["--moment"],
-                                     seconds=budget / len(P["omegas"]) / P["ref_parts"])
-                est_parts.append((ch, st))
-            n = sum(st["spp"] for _, st in est_parts)
-            mean = sum(rgb_of(ch) * st["spp"] for ch, st in est_parts) / n
-            m2 = sum(rgb_of(ch, "m2.") * st["spp"] for ch, st in est_parts) / n
-            mu, se = mean_se_bound(mean, np.maximum(m2 - mean * mean, 0) * n / (n - 1), n)
-            pts.append({"omega": omega, "mean": mu, "se": se, "spp": n,
-                        "seconds": sum(st["seconds"] for _, st in est_parts)})
-            parts += est_parts
-            out.setdefault("images", []).append(mean)
+            xml = variant_xml(refs, name, "volpath", omega)
+            tag = f"{name}.ref.omega{omega:g}.s{P['ref_scale']}"
+            per_part, run_spp = planned_spp(args, P, refs, name, xml, f"{name}.volpath.omega{omega:g}",
+                                            P["ref_factor"] * P["ds_factor"])
+            parts = render_parts(args, P, refs, name, xml, tag, per_part, 5000)
+            mean, var, n = pooled(parts)
+            mu, se = mean_se_bound(mean, var, n)
+            pts.append({"omega": omega, "mean": mu, "se": se, "spp": n, "idle_run_spp_predicted": run_spp,
+                        "seconds": sum(st["seconds"] for _, st in parts)})
         if any(p["se"] <= 0 for p in pts):  # a radius never hit: no extrapolation
             pts = [dict(p, se=math.inf if p["se"] <= 0 else p["se"]) for p in pts]
         x = np.array([p["omega"] for p in pts])
@@ -389,31 +467,25 @@ def reference(args, P, work, name):
             cov, coef, chi2 = np.full((2, 2), np.nan), np.full(2, np.nan), math.nan
         out.update(mean=float(coef[0]), se=float(math.sqrt(cov[0, 0])), slope=float(coef[1]), chi2=chi2,
                    dof=len(pts) - 2, points=pts, seconds=sum(p["seconds"] for p in pts),
-                   spp=sum(p["spp"] for p in pts))
+                   spp=sum(p["spp"] for p in pts), image=None)
         # No per-pixel reference here (only the extrapolated mean): relMSE is not reported. The
         # volpath renders of the sphere lights are too sparse for a per-pixel median, so d comes from
         # independent volpath_snee renders (seeds the runs never use; d only weights pixels).
-        out.pop("images")
-        out["image"] = None
-        out["d_from"] = f"volpath_snee, {P['ref_parts']} x {2 * P['run_time']:g} s (seeds 6000+)"
-        parts = [snee_render(args, work, variant_xml(work, name, "snee"), f"{name}.d.{k}", seed=6000 + k,
-                             seconds=2 * P["run_time"]) for k in range(P["ref_parts"])]
+        xml = variant_xml(refs, name, "snee")
+        per_part, _ = planned_spp(args, P, refs, name, xml, f"{name}.snee", P["d_factor"])
+        parts = render_parts(args, P, refs, name, xml, f"{name}.d.s{P['ref_scale']}", per_part, 6000)
+        out["d_from"] = f"volpath_snee, {len(parts)} x {per_part} spp (seeds 6000+)"
         out["d"] = robust_d(parts)
         out["mean_lum"] = float(np.mean([(rgb_of(ch) @ LUM).mean() for ch, _ in parts]))
     else:
-        out["kind"] = f"volpath, {P['ref_parts']} x {budget / P['ref_parts']:g} s"
-        xml = variant_xml(work, name, "volpath")
-        for k in range(P["ref_parts"]):
-            parts.append(snee_render(args, work, xml, f"{name}.ref.{k}", seed=5000 + k, extra=["--moment"],
-                                     seconds=budget / P["ref_parts"]))
-        n = sum(st["spp"] for _, st in parts)
-        mean = sum(rgb_of(ch) * st["spp"] for ch, st in parts) / n
-        m2 = sum(rgb_of(ch, "m2.") * st["spp"] for ch, st in parts) / n
-        var = np.maximum(m2 - mean * mean, 0) * n / (n - 1)
+        xml = variant_xml(refs, name, "volpath")
+        per_part, run_spp = planned_spp(args, P, refs, name, xml, f"{name}.volpath", P["ref_factor"])
+        parts = render_parts(args, P, refs, name, xml, f"{name}.ref.s{P['ref_scale']}", per_part, 5000, need_spp)
+        mean, var, n = pooled(parts)
         mu, se = mean_se_bound(mean, var, n)
-        out.update(mean=mu, se=se, image=mean, var_of_image=var / n)
+        out["kind"] = f"volpath, {len(parts)} x {per_part} spp"
+        out.update(mean=mu, se=se, image=mean, var_of_image=var / n, spp=n, idle_run_spp_predicted=run_spp)
         out["seconds"] = sum(st["seconds"] for _, st in parts)
-        out["spp"] = n
         out["d"] = robust_d(parts)
         out["d_from"] = "the reference's parts"
         out["mean_lum"] = float((mean @ LUM).mean())
@@ -422,14 +494,30 @@ def reference(args, P, work, name):
 
 
 def robust_d(parts):
-    """Per-pixel, per-channel median over independent renders of their 3x3 box-filtered images:
-    the smoothing gives each estimate 9 pixels' samples, the median drops a part's fireflies."""
-    imgs = []
-    for ch, _ in parts:
-        x = np.pad(rgb_of(ch), ((1, 1), (1, 1), (0, 0)), mode="edge")
-        h, w = x.shape[0] - 2, x.shape[1] - 2
-        imgs.append(sum(x[dy:dy + h, dx:dx + w] for dy in range(3) for dx in range(3)) / 9.0)
-    return np.median(np.stack(imgs), axis=0)
+    """Per-pixel, per-channel median over independent renders: the median drops a part's fireflies.
+    (The parts are at 1/ref_scale resolution: each pixel already pools ref_scale^2 run pixels' area.)"""
+    return np.median(np.stack([rgb_of(ch) for ch, _ in parts]), axis=0)
+
+
+def downsample(img, s):
+    """Mean over s x s pixel blocks (with the box filter: the image at 1/s resolution)."""
+    h, w = img.shape[:2]
+    return img.reshape(h // s, s, w // s, s, -1).mean(axis=(1, 3))
+
+
+def upsample(img, s):
+    return np.repeat(np.repeat(img, s, axis=0), s, axis=1)
+
+
+def complete_check(args, work, name):
+    """Whether `connection = complete` renders anything else than the default `paper` here: one
+    4-spp render of each at the same seed, compared pixel by pixel (where the manifold connection
+    does not apply it draws nothing, and the two images are identical)."""
+    a, _ = snee_render(args, work, variant_xml(work, name, "snee"), f"{name}.snee.check", seed=33, spp=4)
+    b, st = snee_render(args, work, variant_xml(work, name, "complete"), f"{name}.complete.check", seed=33, spp=4)
+    same = all(np.array_equal(a[c], b[c]) for c in "RGB")
+    return {"differs": not same, "manifold_attempts": st.get("manifold_attempts"),
+            "manifold_solutions": st.get("manifold_solutions")}
 
 
 def run_config(args, P, work, name):
@@ -443,19 +531,23 @@ def run_config(args, P, work, name):
     t_cfg = time.time()
     load0 = os.getloadavg()[0]
     rendered0 = RENDERED[0]
-    ref = reference(args, P, work, name)
-    denom = ref["d"] ** 2 + ref["eps"]
-    res = {"name": name, "reference": {k: v for k, v in ref.items() if k not in ("image", "d", "var_of_image")}}
-    if "var_of_image" in ref:
-        res["reference"]["rv"] = float(np.mean(ref["var_of_image"] / denom))
+    res = {"name": name}
+    timing = {}
 
-    # Probes (rates), then interleaved runs at fixed spp.
+    # Which snee methods: `complete` only where it differs from `paper`.
+    t1 = time.time()
+    check = complete_check(args, work, name)
+    res["complete"] = check
+    snee_methods = ["volpath", "snee"] + (["complete"] if check["differs"] else [])
+
+    # Probes (rates; a fraction of a run's budget), then the reference (topped up to ref_factor x the
+    # volpath runs' spp if an idle machine outran its plan), then interleaved runs at fixed spp.
     mit = Mitsuba(args, name) if not args.no_mitsuba else None
-    runs = {"volpath": [], "snee": [], "mitsuba": []}
+    runs = {m: [] for m in snee_methods + ["mitsuba"]}
     spp, mstat = {}, {}
-    for m in ("volpath", "snee"):
+    for m in snee_methods:
         _, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.probe", seed=90,
-                            seconds=P["run_time"])
+                            seconds=P["probe"] * P["run_time"])
         spp[m] = max(2, int(round(st["spp"] / st["seconds"] * P["run_time"])))
     if mit is not None:
         rdir = os.path.join(work, "renders")
@@ -466,9 +558,6 @@ def run_config(args, P, work, name):
             if os.path.exists(setup_json):
                 with open(setup_json) as fh:
                     mstat = json.load(fh)
-            elif os.path.exists(res_path):  # written before set-up files existed: the earlier result has it
-                with open(res_path) as fh:
-                    mstat = json.load(fh).get("mitsuba", {})
             with open(os.path.join(rdir, f"{name}.mitsuba.run0.json")) as fh:
                 spp["mitsuba"] = json.load(fh)["spp"]
         else:
@@ -480,10 +569,24 @@ def run_config(args, P, work, name):
                          "load_seconds": mit.info["load_seconds"], "thread_count": mit.info["thread_count"]}
                 os.makedirs(rdir, exist_ok=True)
                 common.write_json_atomic(setup_json, mstat)
+    timing["check_probes_setup"] = time.time() - t1
+    t1 = time.time()
+    ref = reference(args, P, args.refs, name, need_spp=P["ref_factor"] * spp["volpath"])
+    timing["reference_top_up"] = time.time() - t1
+    s_ref = P["ref_scale"]
+    denom_ref = ref["d"] ** 2 + ref["eps"]  # at the reference's resolution
+    denom = upsample(denom_ref, s_ref)  # at the runs' resolution: each run pixel gets its block's d
+    res["reference"] = {k: v for k, v in ref.items() if k not in ("image", "d", "var_of_image")}
+    if "var_of_image" in ref:
+        res["reference"]["rv"] = float(np.mean(ref["var_of_image"] / denom_ref))
+        res["reference"]["spp_over_volpath_run_spp"] = ref["spp"] / spp["volpath"]
+
+    t1 = time.time()
+    seeds = {"volpath": 100, "snee": 200, "complete": 300}
     for i in range(P["runs"]):
-        for m in ("volpath", "snee"):
+        for m in snee_methods:
             ch, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.run{i}",
-                                 seed=(100 if m == "volpath" else 200) + i, spp=spp[m], extra=["--moment"])
+                                 seed=seeds[m] + i, spp=spp[m], extra=["--moment"])
             runs[m].append({"x": rgb_of(ch), "var": moment_var(ch, st["spp"]), "n": st["spp"], "t": st["seconds"]})
         if "mitsuba" in spp:
             npy = os.path.join(work, "renders", f"{name}.mitsuba.run{i}.npy")
@@ -502,12 +605,14 @@ def run_config(args, P, work, name):
         runs["mitsuba"] = []
     res["mitsuba_status"] = "not run (--no-mitsuba)" if mit is None else mit.status
     res["mitsuba"] = mstat
+    timing["runs"] = time.time() - t1
 
     # Firefly renders.
+    t1 = time.time()
     k = P["firefly_scale"]
-    w, h = ref["d"].shape[1], ref["d"].shape[0]
+    w, h = film_size(name)
     ff = {}
-    for m in ("volpath", "snee"):
+    for m in snee_methods:
         ch, _ = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.firefly", seed=77, spp=1,
                             extra=["-D", f"width={w * k}", "-D", f"height={h * k}"])
         ff[m] = firefly_rate(rgb_of(ch), ref["mean_lum"])
@@ -517,16 +622,19 @@ def run_config(args, P, work, name):
             mit.call({"cmd": "firefly", "scale": k, "seed": 77, "out": npy})
         if os.path.exists(npy):
             ff["mitsuba"] = firefly_rate(np.load(npy).astype(np.float64), ref["mean_lum"])
+    if mit is not None:
+        mit.close()
+    timing["firefly"] = time.time() - t1
 
-    # Transport classes (when the binary has them).
+    # Transport classes (when the binary has them): one more run per snee method, untimed.
+    t1 = time.time()
     classes = {}
     if args.classes:
-        for m in ("volpath", "snee"):
+        for m in snee_methods:
             ch, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.classes", seed=400,
                                  spp=spp[m], extra=["--moment", "--classes"])
             classes[m] = class_shares(ch, st["spp"], denom)
-    if mit is not None:
-        mit.close()
+    timing["classes"] = time.time() - t1
 
     # Per-method statistics.
     N = P["runs"]
@@ -572,10 +680,13 @@ def run_config(args, P, work, name):
             tstat = zscore(mu, se, ref["mean"], ref["se"])
             s["t_stat"] = tstat
             z = math.copysign(float(norm.isf(student_t.sf(abs(tstat), N - 1))), tstat) if math.isfinite(tstat) else tstat
+        # relMSE at the reference's resolution (the runs' averages downsampled: with the box filter
+        # that is the image the reference estimates).
         s.update(mean=mu, se=se, z=z,
-                 relmse=None if ref["image"] is None else common.rel_mse(a, ref["image"], denom),
+                 relmse=None if ref["image"] is None else common.rel_mse(downsample(a, s_ref), ref["image"], denom_ref),
                  relmse_k={} if ref["image"] is None else
-                 {str(kk): common.rel_mse(X[:kk].mean(axis=0), ref["image"], denom) for kk in (1, 2, 4, 8) if kk <= N},
+                 {str(kk): common.rel_mse(downsample(X[:kk].mean(axis=0), s_ref), ref["image"], denom_ref)
+                  for kk in RUN_COUNTS if kk <= N},
                  firefly_per_1e6=ff.get(m))
         s["_X"] = X
         s["_vspread"] = v_spread
@@ -586,12 +697,14 @@ def run_config(args, P, work, name):
         v = s["_vspread"](idx) if m == "mitsuba" else float(np.mean(np.array(s["V_runs"])[idx]))
         return safe_div(1.0, v * float(np.sum(np.array(s["t"])[idx]) / (len(idx) * s["spp"])))
 
-    ratios = {}
-    for other in ("volpath", "mitsuba"):
-        if "snee" in stats and other in stats:
-            r = safe_div(stats["snee"]["efficiency"], stats[other]["efficiency"])
-            lo, hi = common.bootstrap_ci(lambda idx, o=other: safe_div(eff("snee", idx), eff(o, idx)), N, b=P["boot"])
-            ratios[other] = {"ratio": r, "lo": lo, "hi": hi}
+    ratios = {}  # volpath_snee over each other method; "complete/...": connection = complete over them
+    for num, other, key in (("snee", "volpath", "volpath"), ("snee", "mitsuba", "mitsuba"),
+                            ("complete", "snee", "complete/snee"), ("complete", "volpath", "complete/volpath"),
+                            ("complete", "mitsuba", "complete/mitsuba")):
+        if num in stats and other in stats:
+            r = safe_div(stats[num]["efficiency"], stats[other]["efficiency"])
+            lo, hi = common.bootstrap_ci(lambda idx, a=num, o=other: safe_div(eff(a, idx), eff(o, idx)), N, b=P["boot"])
+            ratios[key] = {"ratio": r, "lo": lo, "hi": hi}
     for m in stats:
         v = stats[m]
         v["V_ci"] = list(common.bootstrap_ci(lambda idx, m=m: (stats[m]["_vspread"](idx) if m == "mitsuba" else
@@ -601,8 +714,10 @@ def run_config(args, P, work, name):
     res["methods"] = stats
     res["ratios"] = ratios
     res["classes"] = classes
+    res["classes_sum_ok"] = all(c["sum_max_rel_diff"] <= CLASS_SUM_TOL for c in classes.values()) if classes else None
 
     # Figure 3: equal samples, SNEE's transport only.
+    t1 = time.time()
     f3 = {}
     for v in ("fig3_forward", "fig3_snee"):
         ch, st = snee_render(args, work, variant_xml(work, name, v), f"{name}.{v}", seed=7, spp=P["fig3_spp"],
@@ -611,16 +726,39 @@ def run_config(args, P, work, name):
     res["fig3"] = {"forward_mean": f3["fig3_forward"][1], "snee_mean": f3["fig3_snee"][1],
                    "z_forward_vs_snee": zscore(f3["fig3_forward"][1], f3["fig3_forward"][2],
                                                f3["fig3_snee"][1], f3["fig3_snee"][2])}
+    timing["fig3"] = time.time() - t1
+    res["timing"] = timing
     res["wall_seconds"] = time.time() - t_cfg
     res["load_average"] = [load0, os.getloadavg()[0]]
     if RENDERED[0] == rendered0 and os.path.exists(res_path):  # nothing rendered: keep the rendering run's
         with open(res_path) as fh:
             old = json.load(fh)
         res["wall_seconds"], res["load_average"] = old.get("wall_seconds"), old.get("load_average")
-    np.savez_compressed(img_path, ref=ref["d"] if ref["image"] is None else ref["image"], f3_forward=f3["fig3_forward"][0], f3_snee=f3["fig3_snee"][0],
+        res["timing"] = old.get("timing", timing)
+    np.savez_compressed(img_path, ref=upsample(ref["d"] if ref["image"] is None else ref["image"], s_ref), f3_forward=f3["fig3_forward"][0], f3_snee=f3["fig3_snee"][0],
                         **{f"avg_{m}": a for m, a in avg.items()})
     common.write_json_atomic(res_path, finite(res))
     return finite(res)
+
+
+# A-priori time model of one configuration on an idle machine (seconds; calibrated on the smoke and
+# one-configuration runs, see figures/README.md): per snee render, process start and scene loading;
+# Mitsuba: worker start, scene load, probe and kernel compilation, and the firefly render's reload.
+SNEE_START = 0.25
+MITSUBA_SETUP = 20.0
+FIXED_PER_CONFIG = 8.0  # complete check, firefly renders, Figure 3 renders
+
+
+def estimate_seconds(P, names, complete_configs):
+    """Predicted wall time of the runs (references cached): every method renders a probe and the runs
+    of run_time each, snee methods one more (classes) at about 1.3 run_time."""
+    total = 0.0
+    for name in names:
+        m_snee = 3 if name in complete_configs else 2
+        per_run = m_snee * (P["run_time"] + SNEE_START) + P["run_time"]
+        total += (P["runs"] * per_run + m_snee * (P["probe"] * P["run_time"] + SNEE_START)
+                  + m_snee * (1.3 * P["run_time"] + SNEE_START) + MITSUBA_SETUP + P["run_time"] + FIXED_PER_CONFIG)
+    return total
 
 
 def run_config_task(argv, name):
@@ -642,6 +780,10 @@ def finite(x):
     if isinstance(x, np.integer):
         return int(x)
     return x
+
+
+def pct(x):
+    return "–" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{100 * x:.0f}"
 
 
 def fmt(x, digits=3):
@@ -694,8 +836,9 @@ def grid_png(path, title, tiles, note):
 
 def chart_png(path, results, P, note):
     """Relative error against render time per configuration: RV(t) = V c / t (band: the bootstrap
-    interval of V) for k = 1, 2, 4, 8 runs averaged, and relMSE of those averages against the
-    reference (markers); dotted: the reference's own RV."""
+    interval of V) for k = 1, 2, 4, ... runs averaged, and relMSE of those averages against the
+    reference (markers, at the reference's resolution: about RV / ref_scale^2 + RV_ref + bias^2);
+    dotted: the reference's own RV."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -719,7 +862,7 @@ def chart_png(path, results, P, note):
                 s = res["methods"].get(key)
                 if not s:
                     continue
-                ks = np.array([kk for kk in (1, 2, 4, 8) if kk <= P["runs"]])
+                ks = np.array([kk for kk in RUN_COUNTS if kk <= P["runs"]])
                 tk = ks * float(np.mean(s["t"]))
                 rv = s["V"] * s["c"] / tk
                 lo, hi = (np.array(s["V_ci"]) * s["c"])[:, None] / tk[None, :] if s.get("V_ci") and None not in s["V_ci"] else (rv, rv)
@@ -734,7 +877,7 @@ def chart_png(path, results, P, note):
                 hr = ax.axhline(rv_ref, color="gray", ls=":", lw=0.8, label="reference's own RV")
                 handles[hr.get_label()] = hr
             ax.xaxis.set_major_locator(FixedLocator([float(np.mean(res["methods"][m]["t"])) * kk for m in
-                                                     list(res["methods"])[:1] for kk in (1, 2, 4, 8)]))
+                                                     list(res["methods"])[:1] for kk in RUN_COUNTS if kk <= P["runs"]]))
             ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
             ax.xaxis.set_minor_locator(NullLocator())
             ax.yaxis.set_minor_formatter(NullFormatter())
@@ -744,7 +887,7 @@ def chart_png(path, results, P, note):
                 ax.set_xlabel("render time [s]", fontsize=8)
     fig.legend(list(handles.values()), list(handles.keys()), loc="lower center", ncol=4, fontsize=8, frameon=False)
     fig.suptitle(f"relative error against render time (lines: RV = V c / t with 95 % bootstrap band; markers: relMSE "
-                 f"of 1, 2, 4, 8 runs averaged against the reference); {note}", fontsize=9)
+                 f"of 1, 2, 4, ... runs averaged against the reference, at its 1/{P['ref_scale']} resolution); {note}", fontsize=9)
     fig.tight_layout(rect=(0, 0.06, 1, 0.97), h_pad=0.6, w_pad=0.4)
     fig.savefig(path, dpi=100)
     plt.close(fig)
@@ -770,6 +913,18 @@ def report(args, P, mode, work, names, results, total, load):
             flag = " †"
         return f"{fmt(q['ratio'])} [{fmt(q['lo'])}, {fmt(q['hi'])}]{flag}"
 
+    def complete_cell(r):
+        c = r.get("complete") or {}
+        if not c.get("differs"):
+            return "same as paper (draws no manifold sample here)"
+        q = r["ratios"].get("complete/snee")
+        s = r["methods"].get("complete")
+        if not q or not s:
+            return "not run"
+        z = s["z"]
+        zs = "n/a" if z is None else (f"**{z:.1f}**" if abs(z) > zcrit else f"{z:.1f}")
+        return f"{fmt(q['ratio'])} [{fmt(q['lo'])}, {fmt(q['hi'])}], z {zs}"
+
     def z_cell(r):
         cells = []
         for m in ("volpath", "snee", "mitsuba"):
@@ -783,24 +938,31 @@ def report(args, P, mode, work, names, results, total, load):
 
     head = ("| configuration | eff. volpath_snee / volpath [95 %] | eff. volpath_snee / Mitsuba volpath [95 %] | "
             f"bias z vs reference: volpath / snee / Mitsuba (bold: \\|z\\| > {zcrit:.2f}) | "
-            "fireflies per 10⁶ samples: volpath / snee / Mitsuba | reference (error of its mean) | "
+            "eff. `connection = complete` / volpath_snee (paper) [95 %], its z | "
+            "fireflies per 10⁶ samples: volpath / snee / Mitsuba | reference (error of its mean; spp ÷ a volpath run's) | "
             "relMSE vs ref: volpath / snee / Mitsuba |")
-    lines = [head, "|" + "---|" * 7]
+    lines = [head, "|" + "---|" * 8]
     for name in names:
         r = results[name]
         ref = r["reference"]
         ff = " / ".join(fmt(r["methods"].get(m, {}).get("firefly_per_1e6"), 2) for m in ("volpath", "snee", "mitsuba"))
         rm = " / ".join(fmt(r["methods"].get(m, {}).get("relmse"), 2) for m in ("volpath", "snee", "mitsuba"))
         kind = "sphere → 0 sr" if "sphere" in ref["kind"] else "volpath"
-        lines.append(f"| {name} | {ratio_cell(r, 'volpath')} | {ratio_cell(r, 'mitsuba')} | {z_cell(r)} | {ff} | "
-                     f"{kind}, ±{fmt(100 * ref['se'] / max(abs(ref['mean']), 1e-30) if ref.get('se') is not None else None, 2)} % | {rm} |")
+        factor = ref.get("spp_over_volpath_run_spp")
+        factor = f"; ×{factor:.0f}" if factor else ""
+        lines.append(f"| {name} | {ratio_cell(r, 'volpath')} | {ratio_cell(r, 'mitsuba')} | {z_cell(r)} | "
+                     f"{complete_cell(r)} | {ff} | {kind}, ±"
+                     f"{fmt(100 * ref['se'] / max(abs(ref['mean']), 1e-30) if ref.get('se') is not None else None, 2)} %"
+                     f"{factor} | {rm} |")
     table = "\n".join(lines)
     render_wall = sum(results[n].get("wall_seconds") or 0.0 for n in names)
     loads = [x for n in names for x in (results[n].get("load_average") or []) if x is not None]
+    ref_wall = sum(results[n].get("timing", {}).get("reference_top_up", 0.0) for n in names)
     summary = (f"mode {mode}: {len(names)} configurations, {P['runs']} runs x {P['run_time']:g} s per method "
-               f"(--threads {args.threads}), references {P['ref_factor']} x {P['run_time']:g} s; rendering wall time "
-               f"{render_wall / 60:.1f} min (all configurations, references included) at a load average of "
-               f"{min(loads, default=0):.1f}-{max(loads, default=0):.1f} (2 cores shared with other jobs); {mi_note}.")
+               f"(--threads {args.threads}); references: snee volpath at 1/{P['ref_scale']} of the width and height, "
+               f"≥ {P['ref_factor']} x the spp of a volpath run (rendered ahead, {ref_wall / 60:.1f} min of top-up "
+               f"in this run); rendering wall time {render_wall / 60:.1f} min at a load average of "
+               f"{min(loads, default=0):.1f}-{max(loads, default=0):.1f}; {mi_note}.")
     verdicts = []
     for other, label in (("volpath", "snee volpath"), ("mitsuba", "Mitsuba volpath")):
         black = [n for n in names if results[n]["methods"].get(other, {}).get("mean") == 0.0]
@@ -808,22 +970,36 @@ def report(args, P, mode, work, names, results, total, load):
         q = [x for x in q if x and x.get("lo") is not None and x.get("hi") is not None]
         win = sum(1 for x in q if x["lo"] > 1)
         lose = sum(1 for x in q if x["hi"] < 1)
+        undecided = [x for x in q if x["lo"] <= 1 <= x["hi"]]
+        equal = sum(1 for x in undecided if x["lo"] >= 1 / (1 + EQUAL_WITHIN) and x["hi"] <= 1 + EQUAL_WITHIN)
+        spans = [math.sqrt(x["hi"] / x["lo"]) for x in q if x["lo"] > 0]
         verdicts.append(f"volpath_snee vs {label}: more efficient (95 % interval above 1) in {win}, less efficient "
-                        f"(below 1) in {lose}, undecided in {len(q) - win - lose} of {len(q)} configurations where "
-                        f"both render the transport (in {len(black)} more, {label} renders black)")
+                        f"(below 1) in {lose}, undecided in {len(undecided)} (of them equal within "
+                        f"±{100 * EQUAL_WITHIN:.0f} %: {equal}) of {len(q)} configurations where both render the "
+                        f"transport (in {len(black)} more, {label} renders black); median interval ×/÷ "
+                        f"{fmt(float(np.median(spans)) if spans else None)}")
     summary += " " + "; ".join(verdicts) + "."
-    cls_lines = []
+    cls_names = sorted({k for n in names for c in results[n].get("classes", {}).values() for k in c["share"]},
+                       key=lambda k: (CLASS_ORDER.index(k) if k in CLASS_ORDER else len(CLASS_ORDER), k))
+    cls_lines, diffs = [], []
     for name in names:
         for m, c in results[name].get("classes", {}).items():
-            shares = ", ".join(f"{k} {v:.2f}" for k, v in sorted(c["share"].items()))
-            cls_lines.append(f"| {name} | {m} | {shares} | {c['sum_max_rel_diff']:.1e} |")
+            cells = " | ".join(f"{pct(c['share'].get(k))} / {pct(c.get('energy', {}).get(k))}" for k in cls_names)
+            diffs.append(c["sum_max_rel_diff"])
+            cls_lines.append(f"| {name} | {dict((k, l) for k, l, _ in METHODS).get(m, m)} | {cells} | "
+                             f"{c['sum_max_rel_diff']:.1e} |")
     text = [f"<!-- written by scripts/reproduce_figures.py --{mode}; do not edit -->", "", summary, "", table, "",
             "† the compared method fails the bias test there (it misses transport): its efficiency is that of an "
             "estimate of a different integral.", ""]
     if cls_lines:
-        text += ["Variance share per transport class (V_class / V from one extra run at the runs' spp):", "",
-                 "| configuration | method | shares | classes' sum vs image (max rel. diff.) |", "|---|---|---|---|",
-                 *cls_lines, ""]
+        missing = [n for n in names if not results[n].get("classes")]
+        ok = sum(1 for d in diffs if d <= CLASS_SUM_TOL)
+        text += [f"Transport classes (docs/classes.md), one extra run per snee method at the runs' spp: each class's "
+                 f"share of V (V_class / V) / of the image's energy, in %. The classes sum to the image (max |sum - "
+                 f"image| / max image ≤ {CLASS_SUM_TOL:g}) in {ok} of {len(diffs)} renders (largest "
+                 f"{max(diffs):.1e})" + (f"; not rendered: {', '.join(missing)}" if missing else "") + ".", "",
+                 "| configuration | method | " + " | ".join(f"`{k}`" for k in cls_names) + " | Σ classes vs image |",
+                 "|" + "---|" * (len(cls_names) + 3), *cls_lines, ""]
     else:
         text += ["Transport classes: this snee binary has no `--classes`; not measured.", ""]
     with open(os.path.join(out, "study.md"), "w") as fh:
@@ -878,6 +1054,9 @@ def parser():
     ap.add_argument("--only", default="*", help="glob over configuration names, e.g. 'directional_*'")
     ap.add_argument("--out", default=None, help="outputs (default figures/ or figures/paper_size/)")
     ap.add_argument("--work", default=None, help="render cache (default target/study/<mode>)")
+    ap.add_argument("--refs", default=None, help="reference cache (default WORK/refs); may be rendered ahead "
+                    "with --refs-only, on any machine, under any load")
+    ap.add_argument("--refs-only", action="store_true", help="render the references (and their rate probes) only")
     ap.add_argument("--force", action="store_true", help="recompute the configurations' results (renders stay cached)")
     ap.add_argument("--force-renders", action="store_true", help="render everything again")
     ap.add_argument("--no-mitsuba", action="store_true")
@@ -897,6 +1076,7 @@ def setup(argv):
     args.out = os.path.abspath(args.out or os.path.join(ROOT, "figures", {"standard": "", "paper": "paper_size", "smoke": "smoke"}[mode]))
     args.classes = common.snee_supports(SNEE, "--classes")
     work = os.path.abspath(args.work or os.path.join(ROOT, "target", "study", mode))
+    args.refs = os.path.abspath(args.refs or os.path.join(work, "refs"))
     return args, P, work
 
 
@@ -913,7 +1093,20 @@ def main():
     print(f"mode {args.mode}: {len(names)} configurations, {P['runs']} runs x {P['run_time']:g} s, reference "
           f"{P['ref_factor']} x, --threads {args.threads}, transport classes: "
           f"{'yes' if args.classes else 'not in this binary'}; load average {load0:.2f}", flush=True)
+    smooth = [n for n in names if "_smooth_" in n]
+    est0, est1 = estimate_seconds(P, names, []), estimate_seconds(P, names, smooth)
+    print(f"estimated wall time with cached references on an idle machine: {est0 / 60:.1f} min, "
+          f"{est1 / 60:.1f} min if `connection = complete` differs from paper on the {len(smooth)} smooth "
+          f"configurations", flush=True)
     results = {}
+    if args.refs_only:  # directional + smooth (the largest) last
+        for name in sorted(names, key=lambda n: n.startswith("directional_smooth")):
+            t1 = time.time()
+            ref = reference(args, P, args.refs, name)
+            print(f"{name}: reference {ref['kind']}, {ref['spp']} spp, mean {ref['mean']:.5g} +- {ref['se']:.2g}, "
+                  f"{ref['seconds']:.0f} s rendering [{time.time() - t1:.0f} s, total {time.time() - t0:.0f} s, "
+                  f"load {os.getloadavg()[0]:.1f}]", flush=True)
+        return 0
     if args.ray or args.paper or args.address:
         import ray
         ray.init(address=args.address or "local", include_dashboard=False, log_to_driver=False,
@@ -938,7 +1131,9 @@ def main():
                   f"{fmt(q.get('volpath', {}).get('ratio'))} [{fmt(q.get('volpath', {}).get('lo'))}, "
                   f"{fmt(q.get('volpath', {}).get('hi'))}], snee/Mitsuba {fmt(q.get('mitsuba', {}).get('ratio'))}; "
                   f"z " + " / ".join(fmt(s['z'], 2) for s in r["methods"].values()) +
-                  f"; {r['wall_seconds']:.0f} s, load {r['load_average'][1]:.2f}  [{time.time() - t0:.0f} s]", flush=True)
+                  f"; {r['wall_seconds']:.0f} s, load {r['load_average'][1]:.2f}  [{time.time() - t0:.0f} s, "
+                  f"projected total {(time.time() - t0) / (k + 1) * len(names) / 60:.1f} min]", flush=True)
+        print(f"wall time: {(time.time() - t0) / 60:.1f} min (estimated {est0 / 60:.1f}-{est1 / 60:.1f} min)", flush=True)
     report(args, P, args.mode, work, names, results, time.time() - t0, [load0, os.getloadavg()[0]])
     return 0
 
