@@ -4,37 +4,52 @@ volpath and Mitsuba 3's volpath, on the 18 configurations of scenes/paper/ (writ
 scripts/make_figure_assets.py): light in {envmap, sphere (0.006 sr), directional}, boundary in {ggx020,
 ggx004, smooth}, extinction in {st02 (2 /m), st34 (34 /m)}; medium albedo 0.8, isotropic.
 
-    python3 scripts/reproduce_figures.py --standard     # <= 60 min on 2 cores; outputs in figures/
+    python3 scripts/reproduce_figures.py --standard --refs-only --refs DIR   # references ahead, any load
+    python3 scripts/reproduce_figures.py --standard --refs DIR --work WORK   # ~30 min on 2 idle cores
     python3 scripts/reproduce_figures.py --paper [--address auto]   # Ray cluster; figures/paper_size/
 
-Per configuration (one after the other; cached per render and per configuration in --work, so an
-interrupted run resumes where it stopped; --force renders again):
+Per configuration (one after the other; cached per render and per configuration in --work, the
+references in --refs, so an interrupted run resumes where it stopped; --force recomputes the
+results from the cached renders, --force-renders renders again):
 
-Reference (never produced by a compared method's runs):
+Reference (never produced by a compared method's runs), rendered by spp, not by time, so it can be
+rendered ahead on a loaded machine (--refs-only) and reused:
+  * resolution 1/ref_scale (2) of the width and height: with the box filter each reference pixel
+    estimates the mean of a 2 x 2 block of run pixels, so the image mean (the bias test) is the
+    same integral, relMSE compares the runs' 2 x 2 block averages with it, and d is replicated to
+    the block's four pixels. A quarter of the pixels makes ref_factor x the spp affordable.
   * wherever volpath converges (every configuration except directional + smooth): snee `volpath`,
-    REF_PARTS independent renders (distinct seeds) of REF_FACTOR * RUN_TIME / REF_PARTS seconds each,
-    so the reference gets REF_FACTOR (100) times one run's budget. Reference = spp-weighted mean.
+    ref_parts (8) independent renders (seeds 5000+) of equal spp, together >= ref_factor (100) x
+    the spp of one volpath run. The spp are planned ahead from volpath's CPU-time rate (1 thread,
+    measured where the reference renders: REFS/plan/) x threads x run_time x REF_HEADROOM (1.25:
+    idle cores are faster than loaded ones); if the runs' probe finds a faster machine, the
+    reference is topped up with more parts of the same spp, so the factor always holds.
   * directional + smooth (volpath cannot sample a delta light through a delta boundary): the same
     scene with the directional light replaced by a sphere light of solid angle Omega in the same
     direction at 1 km with the same irradiance (radiance E / (pi sin^2 alpha)), rendered with
-    `volpath` for each Omega in OMEGAS (the budget split evenly), and the image mean extrapolated
-    linearly in Omega to Omega = 0 (weighted least squares). Its error: the intercept's standard
-    error, and the fit's chi^2 (1 degree of freedom with 3 radii) as a check of the linear model.
-    (`volpath_snee connection=complete` would be exact here only for flat boundaries; the statue is
-    curved.)
+    `volpath` for each Omega in OMEGAS, each at ds_factor (1) x ref_factor x a planned run's spp of
+    that scene, and the image mean extrapolated linearly in Omega to Omega = 0 (weighted least
+    squares). Its error: the intercept's standard error, and the fit's chi^2 (1 degree of freedom
+    with 3 radii) as a check of the linear model. d there: ref_parts volpath_snee renders at
+    d_factor (25) x a run's spp (seeds 6000+, which no run uses; d only weights pixels).
   * d, the per-pixel denominator of relative errors: the per-pixel, per-channel MEDIAN of the
-    reference's independent parts (all radii for directional + smooth): robust to fireflies and
-    independent of the runs. Denominator d^2 + eps with eps = 1e-2 * (mean of d)^2.
+    reference's independent parts: robust to fireflies and independent of the runs. Denominator
+    d^2 + eps with eps = 1e-2 * (mean of d)^2.
   * the reference's own error: standard error of its image mean (per-pixel moments; channels
     bounded as fully correlated), and its own relative variance RV_ref = mean(var / (d^2 + eps)).
 
-Runs (interleaved: volpath, volpath_snee, Mitsuba, volpath, ... so all see the same machine load):
-  each method first renders one probe of RUN_TIME seconds (not used) to measure its rate, then RUNS
-  (8) independent runs with distinct seeds at the FIXED spp n = rate * RUN_TIME. snee: --moment,
-  time t from --stats (scene loading excluded). Mitsuba: a persistent worker process (this script
-  with --mitsuba-worker) that loaded the unchanged XML once (default integrator volpath); t is the
-  wall clock around mi.render minus drjit's LLVM compile time; one untimed warm-up at n compiles
-  the kernel first. Variant llvm_ad_rgb (else scalar_rgb), dr.set_thread_count(THREADS).
+Methods: snee `volpath`, snee `volpath_snee` (default `connection = paper`), Mitsuba 3 `volpath`, and
+  snee `volpath_snee connection = complete` where it renders something else than `paper`: decided per
+  configuration by one 4-spp render of each at the same seed, compared pixel by pixel (where the
+  manifold connection does not apply it draws nothing and the images are identical; the table then
+  reads "same as paper").
+Runs (interleaved: volpath, volpath_snee, [complete,] Mitsuba, volpath, ... so all see the same load):
+  each method first renders one probe of probe x RUN_TIME seconds (not used) to measure its rate,
+  then RUNS (16) independent runs with distinct seeds at the FIXED spp n = rate * RUN_TIME. snee:
+  --moment, time t from --stats (scene loading excluded). Mitsuba: a persistent worker process (this
+  script with --mitsuba-worker) that loaded the unchanged XML once (default integrator volpath); t
+  is the wall clock around mi.render minus drjit's LLVM compile time; one untimed warm-up at n
+  compiles the kernel first. Variant llvm_ad_rgb (else scalar_rgb), dr.set_thread_count(THREADS).
 
 Efficiency (per method): V = per-sample relative variance = mean over pixels and channels of
 sigma^2_p / (d_p^2 + eps); c = seconds per sample per pixel = sum t / (RUNS n); a render of time t has
@@ -45,38 +60,46 @@ relative variance RV(t) = V c / t, so efficiency = 1 / (RV t) = 1 / (V c).
     variance (ddof 1) of pixel p over the RUNS runs, E[s^2_p] = sigma^2_p / n, so
     V = n * mean(s^2_p / (d^2 + eps)): the same quantity. snee's methods get this estimate too
     (JSON: V_spread), a check of the moment estimate.
-  * Ratios volpath_snee / volpath and volpath_snee / Mitsuba volpath, with a 95 % percentile
-    bootstrap over runs (run indices resampled jointly for all methods: interleaved runs share the
-    load); a resampled spread estimate is multiplied by RUNS / (RUNS - 1) (the bootstrap's bias
-    of a ddof-1 variance).
+  * Ratios volpath_snee / volpath, volpath_snee / Mitsuba volpath (and complete / volpath_snee),
+    with a 95 % percentile bootstrap over runs (run indices resampled jointly for all methods:
+    interleaved runs share the load); a resampled spread estimate is multiplied by RUNS / (RUNS - 1)
+    (the bootstrap's bias of a ddof-1 variance). An undecided ratio whose interval lies within
+    [1/1.1, 1.1] is counted as "equal within +-10 %".
+  * Why 16 runs x 1 s (figures/README.md, "Choosing the standard size"): V is a mean of squared,
+    heavy-tailed samples; its relative error falls as 1/sqrt(samples per method), and the width of
+    the intervals is set by the samples, not by the number of pixels, so the standard size buys
+    samples (~16 M per method on 2 idle cores) and enough runs (16) for the bootstrap.
   * A ratio where the compared method fails the bias test measures the variance of an estimate of
     a different integral (volpath under directional + smooth is black): flagged in the table.
 Bias: image mean (pixels and channels) of the RUNS-run average against the reference; standard
-  error from the spread of the runs' means (so channel correlations count, also for Mitsuba), plus
+  error from the moments (snee) or the spread of the runs' means (Mitsuba, as a t statistic), plus
   the reference's; |z| judged at the Sidak threshold for family-wise 1 % over all tests.
 Firefly rate: each method renders the scene once at FIREFLY_SCALE times the width and height with
   1 spp (box filter: each pixel is one sample, distributed over the film as the samples of the
   normal render); rate = samples per 10^6 whose luminance exceeds 100 x the reference image's mean
   luminance.
-relMSE (secondary): mean of (average of the runs - reference)^2 / (d^2 + eps); its expectation is
-  RV(average) + RV_ref + bias^2, both RVs in the JSON.
+relMSE (secondary): mean over the reference's pixels of (2 x 2 block average of the runs' average -
+  reference)^2 / (d^2 + eps); its expectation is RV(average, at that resolution) + RV_ref + bias^2.
 Transport classes: when `snee render --help` lists --classes, one more untimed run per snee method
-  at n spp with --classes --moment: each class's share of V (V_class / V, from the same samples;
-  shares need not sum to 1: a sample can contribute to several classes), and the classes' sum
-  against the image (max relative difference).
+  at n spp with --classes --moment: each class's share of V (V_class / V, from the same samples) and
+  of the energy, and the classes' sum against the image (max |sum - image| / max image, must be
+  <= CLASS_SUM_TOL = 1e-5, float32 rounding) -- on every configuration.
 Figure 3: equal samples (FIG3_SPP), transport = snee: volpath_snee snee = forward (left halves)
   against snee = mis with snee_rate = 1 (right halves); z of the image means.
 Figure 4: the average of the RUNS runs (equal time) of volpath | volpath_snee, and Mitsuba | snee.
-`volpath_snee connection=complete` is not run: on the curved statue it renders exactly what the
-  default `paper` connection renders (it applies to flat boundaries only; docs/manifold.md).
+
+Time: the script prints an a-priori estimate (estimate_seconds) at the start, a projection after
+each configuration and the wall time at the end; the JSON has each configuration's phases
+(`timing`). References missing from --refs are rendered (or topped up) first and add to it.
 
 Sizes:
-  --standard  RUN_TIME 0.5 s x 8 runs, reference 100 x 0.5 s = 50 s (4 parts), FIG3_SPP 32, 2 threads,
+  --standard  RUN_TIME 1 s x 16 runs (probe 0.25 s), references 1/2 resolution at >= 100 x a volpath
+              run's spp (8 parts), directional + smooth 2 x that per radius, FIG3_SPP 32, 2 threads,
               firefly renders at 6x resolution. Outputs committed in figures/.
-  --paper     RUN_TIME 30 s x 8 runs, reference 3000 s (10 parts), FIG3_SPP 500 (the paper's), 1 thread
-              per task, firefly renders at 16x resolution; each configuration is one Ray task
+  --paper     RUN_TIME 30 s x 8 runs, references >= 100 x (10 parts), FIG3_SPP 500 (the paper's), 1
+              thread per task, firefly renders at 16x resolution; each configuration is one Ray task
               (`ray.init()` here by default, --address to join a cluster started with `ray start`;
-              --work must then be a folder every node sees). Outputs in figures/paper_size/.
+              --work and --refs must then be folders every node sees). Outputs in figures/paper_size/.
   --smoke     seconds per configuration, to check the pipeline (also with --ray); its numbers mean nothing.
 
 Outputs (--out): study.md (the table), study.json (everything), study_error_vs_time.png,
@@ -85,6 +108,7 @@ Requires: cargo build --release; pip install -r scripts/requirements.txt; Ray fo
 """
 import argparse
 import fnmatch
+import glob
 import json
 import math
 import os
@@ -111,7 +135,7 @@ LABEL = {"envmap": "envmap", "sphere": "sphere 0.006 sr", "directional": "direct
          "st02": "sigma_t 2/m", "st34": "sigma_t 34/m"}
 MODES = {
     "standard": {"fig3_spp": 32, "run_time": 1.0, "runs": 16, "probe": 0.25, "ref_factor": 100, "ref_parts": 8,
-                 "ref_scale": 2, "ds_factor": 2, "d_factor": 25, "omegas": [0.006, 0.003, 0.0015],
+                 "ref_scale": 2, "ds_factor": 1, "d_factor": 25, "omegas": [0.006, 0.003, 0.0015],
                  "firefly_scale": 6, "threads": 2, "boot": 2000},
     "paper": {"fig3_spp": 500, "run_time": 30.0, "runs": 8, "probe": 0.25, "ref_factor": 100, "ref_parts": 10,
               "ref_scale": 2, "ds_factor": 2, "d_factor": 25, "omegas": [0.006, 0.003, 0.0015],
@@ -124,7 +148,7 @@ MODES = {
 # The references' spp come from a CPU-time rate measured on the (possibly loaded) machine that renders
 # them; an idle machine's runs get more spp per second (no hyper-thread or cache contention): the
 # planned spp are this factor above the measured rate's prediction.
-REF_HEADROOM = 1.5
+REF_HEADROOM = 1.25
 SPHERE_DISTANCE = 1000.0  # m: the irradiance varies by +-0.1 % over the 1 m statue
 FIREFLY_FACTOR = 100.0
 ALPHA = 0.01  # family-wise level of the bias tests
@@ -207,7 +231,7 @@ def snee_render(args, work, xml, tag, seed, spp=None, seconds=None, extra=()):
     if args.force_renders or not (os.path.exists(out) and os.path.exists(stats)):
         RENDERED[0] += 1
         os.makedirs(os.path.dirname(out), exist_ok=True)
-        cmd = [SNEE, "render", xml, "-o", out, "--seed", str(seed), "--threads", str(args.threads),
+        cmd = [args.snee, "render", xml, "-o", out, "--seed", str(seed), "--threads", str(args.threads),
                "--stats", stats, "-q", *extra]
         cmd += ["--spp", str(spp)] if spp is not None else ["--time", str(seconds)]
         subprocess.run(cmd, check=True)
@@ -394,7 +418,7 @@ def cpu_rate(args, refs, xml, tag):
 
     def cpu(spp):
         r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        subprocess.run([SNEE, "render", xml, "-o", out, "--spp", str(spp), "--threads", "1", "-q"], check=True)
+        subprocess.run([args.snee, "render", xml, "-o", out, "--spp", str(spp), "--threads", "1", "-q"], check=True)
         r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         return (r1.ru_utime + r1.ru_stime) - (r0.ru_utime + r0.ru_stime)
     w, h = film_size(tag.split(".")[0])
@@ -420,6 +444,9 @@ def render_parts(args, P, refs, name, xml, tag, per_part, seed0, need_spp=0):
     """ref_parts renders of per_part spp at 1/ref_scale resolution with --moment (seeds seed0 + k),
     plus as many more as reach need_spp in total (a reference that an idle machine's faster runs
     outgrew is topped up, not replaced)."""
+    done = glob.glob(os.path.join(refs, "renders", glob.escape(tag) + ".*spp.0.json"))
+    if done:  # parts rendered under an earlier plan (another headroom, rate or machine) stay valid
+        per_part = int(re.search(r"\.(\d+)spp\.0\.json$", done[0]).group(1))
     count = max(P["ref_parts"], math.ceil(need_spp / per_part))
     return [snee_render(args, refs, xml, f"{tag}.{per_part}spp.{k}", seed=seed0 + k, spp=per_part,
                         extra=["--moment", *half_size(name, P["ref_scale"])]) for k in range(count)]
@@ -1056,6 +1083,7 @@ def parser():
     ap.add_argument("--work", default=None, help="render cache (default target/study/<mode>)")
     ap.add_argument("--refs", default=None, help="reference cache (default WORK/refs); may be rendered ahead "
                     "with --refs-only, on any machine, under any load")
+    ap.add_argument("--snee", default=SNEE, help="the snee binary (default target/release/snee)")
     ap.add_argument("--refs-only", action="store_true", help="render the references (and their rate probes) only")
     ap.add_argument("--force", action="store_true", help="recompute the configurations' results (renders stay cached)")
     ap.add_argument("--force-renders", action="store_true", help="render everything again")
@@ -1074,7 +1102,8 @@ def setup(argv):
     args.mode = mode
     args.threads = args.threads or P["threads"]
     args.out = os.path.abspath(args.out or os.path.join(ROOT, "figures", {"standard": "", "paper": "paper_size", "smoke": "smoke"}[mode]))
-    args.classes = common.snee_supports(SNEE, "--classes")
+    args.snee = os.path.abspath(args.snee)
+    args.classes = common.snee_supports(args.snee, "--classes")
     work = os.path.abspath(args.work or os.path.join(ROOT, "target", "study", mode))
     args.refs = os.path.abspath(args.refs or os.path.join(work, "refs"))
     return args, P, work
@@ -1086,8 +1115,8 @@ def main():
     if args.mitsuba_worker:
         scene, threads, variant = args.mitsuba_worker
         return mitsuba_worker(scene, int(threads), variant)
-    if not os.path.exists(SNEE):
-        sys.exit(f"{SNEE} not found: run `cargo build --release` first")
+    if not os.path.exists(args.snee):
+        sys.exit(f"{args.snee} not found: run `cargo build --release` first")
     names = [n for n in configs() if fnmatch.fnmatch(n, args.only)]
     t0, load0 = time.time(), os.getloadavg()[0]
     print(f"mode {args.mode}: {len(names)} configurations, {P['runs']} runs x {P['run_time']:g} s, reference "

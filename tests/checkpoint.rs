@@ -1,7 +1,9 @@
 //! Nothing lost: a render killed with SIGKILL after its first checkpoint resumes to the image of
 //! an uninterrupted run; outputs are replaced atomically; `-o` writes what its extension says.
 
-use snee::io::read::{read_image, Bitmap};
+mod common;
+
+use snee::io::read::read_image;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -28,22 +30,6 @@ fn render_args<'a>(out: &'a str, seed: &'a str) -> Vec<&'a str> {
 
 fn run(args: &[&str]) -> std::process::Output {
     Command::new(SNEE).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
-}
-
-fn max_rel_diff(a: &Bitmap, b: &Bitmap) -> f32 {
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    let mut worst = 0.0f32;
-    for (ca, name) in a.channels.iter().enumerate() {
-        let cb = b.channel(name).unwrap_or_else(|| panic!("channel {name} missing"));
-        for i in 0..a.width * a.height {
-            let (x, y) = (a.data[i * a.channels.len() + ca], b.data[i * b.channels.len() + cb]);
-            let scale = x.abs().max(y.abs());
-            if scale > 0.0 {
-                worst = worst.max((x - y).abs() / scale);
-            }
-        }
-    }
-    worst
 }
 
 #[test]
@@ -86,7 +72,7 @@ fn sigkill_after_first_checkpoint_then_resume_gives_the_uninterrupted_image() {
     let resumed = snee::merge::Part::read(&part).unwrap();
     assert_eq!(resumed.meta.range, (0, SPP.parse().unwrap()));
     let (a, b) = (read_image(&full, false).unwrap(), read_image(&part, false).unwrap());
-    let d = max_rel_diff(&a, &b);
+    let d = common::max_rel_diff(&a, &b, &[]);
     eprintln!("resumed vs uninterrupted: max relative difference {d:e}");
     assert!(d <= REL_TOL, "max relative difference {d:e}");
     let _ = std::fs::remove_dir_all(&dir);
@@ -176,8 +162,11 @@ fn resume_continues_a_prefix_of_a_sample_range() {
     assert!(go(base(&direct), &["--sample-range", "3..21"]).status.success());
     let part = snee::merge::Part::read(Path::new(&resumed)).unwrap();
     assert_eq!(part.meta.range, (3, 21));
-    let d =
-        max_rel_diff(&read_image(Path::new(&direct), false).unwrap(), &read_image(Path::new(&resumed), false).unwrap());
+    let d = common::max_rel_diff(
+        &read_image(Path::new(&direct), false).unwrap(),
+        &read_image(Path::new(&resumed), false).unwrap(),
+        &[],
+    );
     eprintln!("range resumed vs direct: max relative difference {d:e}");
     assert!(d <= REL_TOL, "max relative difference {d:e}");
     let o = go(base(&resumed), &["--sample-range", "5..21", "--resume", &prefix]);

@@ -2,6 +2,8 @@
 //! single-process render (locally and through a local Ray cluster started by the test), and
 //! `merge` refuses parts that do not belong together.
 
+mod common;
+
 use snee::io::read::{read_image, Bitmap};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -16,6 +18,8 @@ const SEED: &str = "7";
 /// samples in a different grouping (f32 ε = 1.2e-7), far below the Monte Carlo noise a wrong
 /// or repeated sample would cause (≥ 1e-2 at 21 spp).
 const REL_TOL: f32 = 1e-5;
+/// Channels not compared here: `W`, the filter-weight sums that partial renders carry.
+const SKIP: &[&str] = &["W"];
 
 fn folder(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("snee-distributed-{name}-{}", std::process::id()));
@@ -36,26 +40,6 @@ fn render(out: &Path, extra: &[&str]) {
     args.extend(FILM);
     args.extend(extra);
     snee(&args);
-}
-
-/// Largest relative difference over the channels of `a` (all present in `b`, looked up by name).
-fn max_rel_diff(a: &Bitmap, b: &Bitmap) -> f32 {
-    assert_eq!((a.width, a.height), (b.width, b.height));
-    let mut worst = 0.0f32;
-    for (ca, name) in a.channels.iter().enumerate() {
-        if name == "W" {
-            continue;
-        }
-        let cb = b.channel(name).unwrap_or_else(|| panic!("channel {name} missing"));
-        for i in 0..a.width * a.height {
-            let (x, y) = (a.data[i * a.channels.len() + ca], b.data[i * b.channels.len() + cb]);
-            let scale = x.abs().max(y.abs());
-            if scale > 0.0 {
-                worst = worst.max((x - y).abs() / scale);
-            }
-        }
-    }
-    worst
 }
 
 fn single_run(dir: &Path) -> Bitmap {
@@ -92,14 +76,14 @@ fn ranges_2_3_7_merge_to_the_single_run() {
         args.extend(parts.iter().rev().map(|s| s.as_str()));
         snee(&args);
         let m = read_image(&merged, false).unwrap();
-        let d = max_rel_diff(&single, &m);
+        let d = common::max_rel_diff(&single, &m, SKIP);
         eprintln!("{n} ranges: max relative difference {d:e}");
         assert!(d <= REL_TOL, "{n} ranges: max relative difference {d:e}");
     }
     // A full range is the single run, and the merge of one full part is itself.
     let p = dir.join("full_range.exr");
     render(&p, &["--sample-range", &format!("0..{SPP}")]);
-    assert_eq!(max_rel_diff(&single, &read_image(&p, false).unwrap()), 0.0);
+    assert_eq!(common::max_rel_diff(&single, &read_image(&p, false).unwrap(), SKIP), 0.0);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -187,7 +171,7 @@ fn ray_local_cluster_merge_matches_single_process() {
     assert!(st.status.success(), "ray_render.py failed: {}", String::from_utf8_lossy(&st.stderr));
     assert!(marker.exists(), "no worker was killed: the retry was not exercised");
     let merged = read_image(&out, false).unwrap();
-    let d = max_rel_diff(&single, &merged);
+    let d = common::max_rel_diff(&single, &merged, SKIP);
     eprintln!("Ray, 3 tasks, one worker killed and its task retried: max relative difference {d:e}");
     assert!(d <= REL_TOL, "Ray: max relative difference {d:e}");
     let _ = std::fs::remove_dir_all(&dir);

@@ -220,3 +220,26 @@ pub fn medium_cube(integrator: &str, props: &str, bsdf: &str, emitter: &str) -> 
 </scene>"#
     )
 }
+
+/// Largest relative difference |x − y| / max(|x|, |y|) over every pixel of every channel of `a`
+/// except those named in `skip` (each looked up by name in `b`, which must have it; values both
+/// zero count as equal). The check of renders that must agree up to float summation order
+/// (merged sample ranges, resumed checkpoints).
+pub fn max_rel_diff(a: &snee::io::read::Bitmap, b: &snee::io::read::Bitmap, skip: &[&str]) -> f32 {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let mut worst = 0.0f32;
+    for (ca, name) in a.channels.iter().enumerate() {
+        if skip.contains(&name.as_str()) {
+            continue;
+        }
+        let cb = b.channel(name).unwrap_or_else(|| panic!("channel {name} missing"));
+        for i in 0..a.width * a.height {
+            let (x, y) = (a.data[i * a.channels.len() + ca], b.data[i * b.channels.len() + cb]);
+            let scale = x.abs().max(y.abs());
+            if scale > 0.0 {
+                worst = worst.max((x - y).abs() / scale);
+            }
+        }
+    }
+    worst
+}
