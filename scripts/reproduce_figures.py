@@ -592,6 +592,13 @@ def run_config(args, P, work, name):
             if pr is not None:
                 spp["mitsuba"] = max(2, int(round(pr["rate"] * P["run_time"])))
                 mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 3, "out": None})  # warm-up: compiles
+                # The probe's small renders carry a fixed cost per call, so its rate is low: one timed
+                # render at that spp corrects n so that a run takes about run_time, like snee's.
+                t = mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 4, "out": None})
+                if t is not None and t["seconds"] > 0:
+                    pr["rate_probe"] = pr["rate"]
+                    pr["rate"] = spp["mitsuba"] / t["seconds"]
+                    spp["mitsuba"] = max(2, int(round(pr["rate"] * P["run_time"])))
                 mstat = {"variant": mit.info["variant"], "notes": mit.info["notes"], "probe": pr,
                          "load_seconds": mit.info["load_seconds"], "thread_count": mit.info["thread_count"]}
                 os.makedirs(rdir, exist_ok=True)
@@ -784,7 +791,25 @@ def estimate_seconds(P, names, complete_configs):
         m_snee = 3 if name in complete_configs else 2
         per_run = m_snee * (P["run_time"] + SNEE_START) + P["run_time"]
         total += (P["runs"] * per_run + m_snee * (P["probe"] * P["run_time"] + SNEE_START)
-                  + m_snee * (1.3 * P["run_time"] + SNEE_START) + MITSUBA_SETUP + P["run_time"] + FIXED_PER_CONFIG)
+                  + m_snee * (1.3 * P["run_time"] + SNEE_START) + MITSUBA_SETUP + 2 * P["run_time"] + FIXED_PER_CONFIG)
+    return total
+
+
+def missing_reference_seconds(P, refs, names):
+    """Predicted wall time of the reference parts not yet in REFS (idle machine, all threads: a full
+    reference costs ref_factor x REF_HEADROOM x run_time / ref_scale^2 seconds; directional + smooth
+    ds_factor x that per radius plus its d renders)."""
+    one = P["ref_factor"] * REF_HEADROOM * P["run_time"] / P["ref_scale"] ** 2
+    total = 0.0
+    for name in names:
+        if name.startswith("directional_smooth"):
+            jobs = [(f"{name}.ref.omega{o:g}.s{P['ref_scale']}", P["ds_factor"] * one) for o in P["omegas"]]
+            jobs.append((f"{name}.d.s{P['ref_scale']}", one * P["d_factor"] / P["ref_factor"]))
+        else:
+            jobs = [(f"{name}.ref.s{P['ref_scale']}", one)]
+        for tag, cost in jobs:
+            have = len(glob.glob(os.path.join(refs, "renders", glob.escape(tag) + ".*spp.*.json")))
+            total += cost * max(0, P["ref_parts"] - have) / P["ref_parts"]
     return total
 
 
@@ -1109,6 +1134,16 @@ def setup(argv):
     return args, P, work
 
 
+def pid_alive(text):
+    try:
+        os.kill(int(text.strip()), 0)
+    except (ValueError, ProcessLookupError):
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
 def main():
     argv = sys.argv[1:]
     args, P, work = setup(argv)
@@ -1124,17 +1159,28 @@ def main():
           f"{'yes' if args.classes else 'not in this binary'}; load average {load0:.2f}", flush=True)
     smooth = [n for n in names if "_smooth_" in n]
     est0, est1 = estimate_seconds(P, names, []), estimate_seconds(P, names, smooth)
-    print(f"estimated wall time with cached references on an idle machine: {est0 / 60:.1f} min, "
-          f"{est1 / 60:.1f} min if `connection = complete` differs from paper on the {len(smooth)} smooth "
-          f"configurations", flush=True)
+    est_ref = missing_reference_seconds(P, args.refs, names)
+    est0, est1 = est0 + est_ref, est1 + est_ref
+    print(f"estimated wall time on an idle machine: {est0 / 60:.1f} min, {est1 / 60:.1f} min if `connection = "
+          f"complete` differs from paper on the {len(smooth)} smooth configurations (of it {est_ref / 60:.1f} min "
+          f"for reference parts missing from {args.refs})", flush=True)
+    pid_file = os.path.join(args.refs, "refs_only.pid")
+    if not args.refs_only and os.path.exists(pid_file) and pid_alive(open(pid_file).read()):
+        sys.exit(f"a --refs-only run (pid {open(pid_file).read().strip()}) is rendering into {args.refs}: wait for "
+                 f"it or stop it (kill PID; its finished parts stay) and remove {pid_file}")
     results = {}
     if args.refs_only:  # directional + smooth (the largest) last
+        os.makedirs(args.refs, exist_ok=True)
+        pid_file = os.path.join(args.refs, "refs_only.pid")  # present while a --refs-only run renders
+        with open(pid_file, "w") as fh:
+            fh.write(f"{os.getpid()}\n")
         for name in sorted(names, key=lambda n: n.startswith("directional_smooth")):
             t1 = time.time()
             ref = reference(args, P, args.refs, name)
             print(f"{name}: reference {ref['kind']}, {ref['spp']} spp, mean {ref['mean']:.5g} +- {ref['se']:.2g}, "
                   f"{ref['seconds']:.0f} s rendering [{time.time() - t1:.0f} s, total {time.time() - t0:.0f} s, "
                   f"load {os.getloadavg()[0]:.1f}]", flush=True)
+        os.remove(pid_file)
         return 0
     if args.ray or args.paper or args.address:
         import ray
