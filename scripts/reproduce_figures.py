@@ -64,7 +64,9 @@ relative variance RV(t) = V c / t, so efficiency = 1 / (RV t) = 1 / (V c).
     with a 95 % percentile bootstrap over runs (run indices resampled jointly for all methods:
     interleaved runs share the load); a resampled spread estimate is multiplied by RUNS / (RUNS - 1)
     (the bootstrap's bias of a ddof-1 variance). An undecided ratio whose interval lies within
-    [1/1.1, 1.1] is counted as "equal within +-10 %".
+    [1/1.1, 1.1] is counted as "equal within +-10 %". Seed stability: every ratio is also computed
+    from each half of the runs (seeds +0..7 and +8..15, JSON `halves`, with their own bootstrap
+    intervals); the summary counts the configurations whose two halves' intervals overlap.
   * Why 16 runs x 1 s (figures/README.md, "Choosing the standard size"): V is a mean of squared,
     heavy-tailed samples; its relative error falls as 1/sqrt(samples per method), and the width of
     the intervals is set by the samples, not by the number of pixels, so the standard size buys
@@ -688,9 +690,12 @@ def run_config(args, P, work, name):
         xd = (X / np.sqrt(denom)).reshape(N, -1)
         gram = xd @ xd.T / xd.shape[1]
 
-        def v_spread(idx, gram=gram, n=n):
-            w = np.bincount(idx, minlength=N) / N
-            return n * float(w @ np.diag(gram) - w @ gram @ w) * (N / (N - 1)) ** 2
+        def v_spread(idx, resampled=True, gram=gram, n=n):
+            k = len(idx)
+            if k < 2:
+                return math.nan
+            w = np.bincount(idx, minlength=N) / k
+            return n * float(w @ np.diag(gram) - w @ gram @ w) * (k / (k - 1)) ** (2 if resampled else 1)
         s = {"spp": n, "t": t.tolist(), "c": float(t.sum() / (N * n)), "run_means": run_means.tolist(),
              "V_spread": n * float(spread.mean())}
         if m != "mitsuba":
@@ -726,10 +731,14 @@ def run_config(args, P, work, name):
         s["_vspread"] = v_spread
         stats[m] = s
 
-    def eff(m, idx):
+    def eff(m, idx, resampled=True):
         s = stats[m]
-        v = s["_vspread"](idx) if m == "mitsuba" else float(np.mean(np.array(s["V_runs"])[idx]))
+        v = s["_vspread"](idx, resampled) if m == "mitsuba" else float(np.mean(np.array(s["V_runs"])[idx]))
         return safe_div(1.0, v * float(np.sum(np.array(s["t"])[idx]) / (len(idx) * s["spp"])))
+
+    # Seed stability: the same ratio and interval from each half of the runs (seeds +0..N/2-1 and
+    # +N/2..N-1): intervals that do not depend on which seeds ran should overlap.
+    halves = [np.arange(0, N // 2), np.arange(N // 2, 2 * (N // 2))] if N >= 4 else []
 
     ratios = {}  # volpath_snee over each other method; "complete/...": connection = complete over them
     for num, other, key in (("snee", "volpath", "volpath"), ("snee", "mitsuba", "mitsuba"),
@@ -738,7 +747,12 @@ def run_config(args, P, work, name):
         if num in stats and other in stats:
             r = safe_div(stats[num]["efficiency"], stats[other]["efficiency"])
             lo, hi = common.bootstrap_ci(lambda idx, a=num, o=other: safe_div(eff(a, idx), eff(o, idx)), N, b=P["boot"])
-            ratios[key] = {"ratio": r, "lo": lo, "hi": hi}
+            ratios[key] = {"ratio": r, "lo": lo, "hi": hi, "halves": []}
+            for hf in halves:
+                hlo, hhi = common.bootstrap_ci(lambda j, a=num, o=other, hf=hf: safe_div(eff(a, hf[j]), eff(o, hf[j])),
+                                               len(hf), b=P["boot"])
+                ratios[key]["halves"].append({"ratio": safe_div(eff(num, hf, False), eff(other, hf, False)),
+                                              "lo": hlo, "hi": hhi})
     for m in stats:
         v = stats[m]
         v["V_ci"] = list(common.bootstrap_ci(lambda idx, m=m: (stats[m]["_vspread"](idx) if m == "mitsuba" else
@@ -1026,11 +1040,15 @@ def report(args, P, mode, work, names, results, total, load):
         undecided = [x for x in q if x["lo"] <= 1 <= x["hi"]]
         equal = sum(1 for x in undecided if x["lo"] >= 1 / (1 + EQUAL_WITHIN) and x["hi"] <= 1 + EQUAL_WITHIN)
         spans = [math.sqrt(x["hi"] / x["lo"]) for x in q if x["lo"] > 0]
+        hv = [x["halves"] for x in q if len(x.get("halves", [])) == 2 and
+              all(h.get("lo") is not None and h.get("hi") is not None for h in x["halves"])]
+        overlap = sum(1 for a, b in hv if a["lo"] <= b["hi"] and b["lo"] <= a["hi"])
         verdicts.append(f"volpath_snee vs {label}: more efficient (95 % interval above 1) in {win}, less efficient "
                         f"(below 1) in {lose}, undecided in {len(undecided)} (of them equal within "
                         f"±{100 * EQUAL_WITHIN:.0f} %: {equal}) of {len(q)} configurations where both render the "
                         f"transport (in {len(black)} more, {label} renders black); median interval ×/÷ "
-                        f"{fmt(float(np.median(spans)) if spans else None)}")
+                        f"{fmt(float(np.median(spans)) if spans else None)}; the two halves of the runs' seeds give "
+                        f"overlapping intervals in {overlap} of {len(hv)}")
     summary += " " + "; ".join(verdicts) + "."
     cls_names = sorted({k for n in names for c in results[n].get("classes", {}).values() for k in c["share"]},
                        key=lambda k: (CLASS_ORDER.index(k) if k in CLASS_ORDER else len(CLASS_ORDER), k))
