@@ -902,10 +902,10 @@ def grid_png(path, title, tiles, note):
 
 
 def chart_png(path, results, P, note):
-    """Relative error against render time per configuration: RV(t) = V c / t (band: the bootstrap
-    interval of V) for k = 1, 2, 4, ... runs averaged, and relMSE of those averages against the
-    reference (markers, at the reference's resolution: about RV / ref_scale^2 + RV_ref + bias^2);
-    dotted: the reference's own RV."""
+    """Relative error against render time per configuration, at the reference's resolution (1/ref_scale):
+    RV(t) = V c / (t ref_scale^2) (band: the bootstrap interval of V) for k = 1, 2, 4, ... runs
+    averaged, and relMSE of those averages against the reference (markers; expectation RV + RV_ref +
+    bias^2); dotted: the reference's own RV."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -931,8 +931,11 @@ def chart_png(path, results, P, note):
                     continue
                 ks = np.array([kk for kk in RUN_COUNTS if kk <= P["runs"]])
                 tk = ks * float(np.mean(s["t"]))
-                rv = s["V"] * s["c"] / tk
-                lo, hi = (np.array(s["V_ci"]) * s["c"])[:, None] / tk[None, :] if s.get("V_ci") and None not in s["V_ci"] else (rv, rv)
+                # At the reference's resolution (the markers'): a block of s^2 independent pixels with one
+                # d has 1/s^2 of their relative variance, so RV there is exactly V c / (t s^2).
+                k2 = P["ref_scale"] ** 2
+                rv = s["V"] * s["c"] / tk / k2
+                lo, hi = (np.array(s["V_ci"]) * s["c"] / k2)[:, None] / tk[None, :] if s.get("V_ci") and None not in s["V_ci"] else (rv, rv)
                 (hl,) = ax.loglog(tk, rv, color=style["color"], lw=1.2, label=f"{label}: RV")
                 ax.fill_between(tk, lo, hi, color=style["color"], alpha=0.2, lw=0)
                 rm = [s["relmse_k"].get(str(kk), np.nan) for kk in ks]
@@ -953,8 +956,8 @@ def chart_png(path, results, P, note):
             if r == len(LIGHTS) - 1:
                 ax.set_xlabel("render time [s]", fontsize=8)
     fig.legend(list(handles.values()), list(handles.keys()), loc="lower center", ncol=4, fontsize=8, frameon=False)
-    fig.suptitle(f"relative error against render time (lines: RV = V c / t with 95 % bootstrap band; markers: relMSE "
-                 f"of 1, 2, 4, ... runs averaged against the reference, at its 1/{P['ref_scale']} resolution); {note}", fontsize=9)
+    fig.suptitle(f"relative error against render time at the reference's 1/{P['ref_scale']} resolution (lines: RV = V c / "
+                 f"(t {P['ref_scale'] ** 2}) with 95 % bootstrap band; markers: relMSE of 1, 2, 4, ... runs averaged); {note}", fontsize=9)
     fig.tight_layout(rect=(0, 0.06, 1, 0.97), h_pad=0.6, w_pad=0.4)
     fig.savefig(path, dpi=100)
     plt.close(fig)
