@@ -1031,7 +1031,8 @@ def report(args, P, mode, work, names, results, total, load):
     summary = (f"mode {mode}: {len(names)} configurations, {P['runs']} runs x {P['run_time']:g} s per method "
                f"(--threads {args.threads}); references: snee volpath at 1/{P['ref_scale']} of the width and height, "
                f"≥ {P['ref_factor']} x the spp of a volpath run (rendered ahead, {ref_wall / 60:.1f} min of top-up "
-               f"in this run); rendering wall time {render_wall / 60:.1f} min at a load average of "
+               f"in this run); rendering wall time {render_wall / 60:.1f} min (estimated "
+               f"{'-'.join(f'{e / 60:.1f}' for e in getattr(args, 'estimate', [])) or 'n/a'} min) at a load average of "
                f"{min(loads, default=0):.1f}-{max(loads, default=0):.1f}; {mi_note}.")
     verdicts = []
     for other, label in (("volpath", "snee volpath"), ("mitsuba", "Mitsuba volpath")):
@@ -1090,7 +1091,7 @@ def report(args, P, mode, work, names, results, total, load):
                 fh.write(body)
     common.write_json_atomic(os.path.join(out, "study.json"), finite(
         {"mode": mode, "params": P, "threads": args.threads, "z_threshold_sidak": zcrit, "alpha": ALPHA,
-         "wall_seconds": total, "load_average": load, "mitsuba": mi_note, "results": results}))
+         "wall_seconds": total, "estimated_seconds": getattr(args, "estimate", None), "load_average": load, "mitsuba": mi_note, "results": results}))
     # Figures from the cached images.
     fig3, fig4, fig4mi = {}, {}, {}
     for name in names:
@@ -1183,6 +1184,7 @@ def main():
     est0, est1 = estimate_seconds(P, names, []), estimate_seconds(P, names, smooth)
     est_ref = missing_reference_seconds(P, args.refs, names)
     est0, est1 = est0 + est_ref, est1 + est_ref
+    args.estimate = [est0, est1]
     print(f"estimated wall time on an idle machine: {est0 / 60:.1f} min, {est1 / 60:.1f} min if `connection = "
           f"complete` differs from paper on the {len(smooth)} smooth configurations (of it {est_ref / 60:.1f} min "
           f"for reference parts missing from {args.refs})", flush=True)
