@@ -141,6 +141,15 @@ impl Binning {
     }
 }
 
+impl Binning {
+    /// Bin of doubled centroid `c` on one axis: the same float operations as [`Binning::bins`].
+    #[inline(always)]
+    fn bin(&self, c: Vec3A, axis: usize) -> usize {
+        let x = ((c[axis] - self.origin[axis]) * self.scale[axis]).max(0.0).min((self.count - 1) as f32);
+        x as usize & (BINS - 1)
+    }
+}
+
 fn bin_slice(bins: &mut Bins, prims: &[Bounds], binning: &Binning) {
     for p in prims {
         let k = binning.bins(p.centroid2());
@@ -244,7 +253,7 @@ fn split(prims: &mut [Bounds], ids: &mut [u32], c: &Cluster, bins: &mut Bins) ->
             while i < j {
                 let b = p[i];
                 let cen = b.centroid2();
-                if binning.bins(cen)[axis] < first_right {
+                if binning.bin(cen, axis) < first_right {
                     lb.grow(&b);
                     lc.grow_point(cen);
                     i += 1;
@@ -304,14 +313,24 @@ fn cluster_of(prims: &[Bounds]) -> Cluster {
     Cluster { start: 0, end: prims.len(), bounds, centroids }
 }
 
-/// Nodes, packets and lane indices of a (sub)tree; child references are local to it.
+/// Nodes and leaves of a (sub)tree; child references are local to it. Subtrees built in
+/// parallel stay separate parts (`links`) until [`flatten`] copies every part once into the tree.
 struct Part {
     nodes: Vec<Node8>,
-    packets: Vec<TriPacket4>,
-    lane_prims: Vec<u32>,
+    /// Per leaf: the first position in the builder's index array and the triangle count.
+    leaves: Vec<[u32; 2]>,
+    /// Subtrees hanging from slot `slot` of local node `node`, with their local root reference.
+    links: Vec<Link>,
     depth: usize,
     /// Scratch bins for the splits.
     bins: Box<Bins>,
+}
+
+struct Link {
+    node: u32,
+    slot: usize,
+    part: Part,
+    root: u32,
 }
 
 impl Part {
@@ -319,47 +338,51 @@ impl Part {
     fn new(n: usize) -> Part {
         Part {
             nodes: Vec::with_capacity(n / 12 + 1),
-            packets: Vec::with_capacity(n / 3 + 1),
-            lane_prims: Vec::with_capacity(4 * (n / 3 + 1)),
+            leaves: Vec::with_capacity(n / 3 + 1),
+            links: Vec::new(),
             depth: 0,
             bins: Box::new(EMPTY_BINS),
         }
     }
 
-    fn leaf(&mut self, tris: &[[Vec3; 3]], ids: &[u32]) -> u32 {
-        debug_assert!(!ids.is_empty() && ids.len() <= LEAF_SIZE);
-        let mut packet = TriPacket4::EMPTY;
-        let mut lanes = [u32::MAX; LEAF_SIZE];
-        for (lane, &id) in ids.iter().enumerate() {
-            packet.set(lane, tris[id as usize]);
-            lanes[lane] = id;
-        }
-        self.packets.push(packet);
-        self.lane_prims.extend_from_slice(&lanes);
-        LEAF | (self.packets.len() - 1) as u32
+    fn leaf(&mut self, start: usize, len: usize) -> u32 {
+        debug_assert!(len > 0 && len <= LEAF_SIZE);
+        self.leaves.push([start as u32, len as u32]);
+        LEAF | (self.leaves.len() - 1) as u32
     }
 
-    /// Append `sub` (root reference `root`), shifting its references; returns the shifted root.
-    fn append(&mut self, sub: Part, root: u32) -> u32 {
-        let (node_off, packet_off) = (self.nodes.len() as u32, self.packets.len() as u32);
-        let shift = |c: u32| {
-            if c == EMPTY {
-                c
-            } else if c & LEAF != 0 {
-                LEAF | ((c & !LEAF) + packet_off)
-            } else {
-                c + node_off
-            }
-        };
-        self.nodes.extend(sub.nodes.into_iter().map(|mut n| {
-            n.child = n.child.map(shift);
-            n
-        }));
-        self.packets.extend(sub.packets);
-        self.lane_prims.extend(sub.lane_prims);
-        self.depth = self.depth.max(sub.depth);
-        shift(root)
+    /// Nodes and leaves of this part and all linked ones.
+    fn sizes(&self) -> (usize, usize) {
+        self.links.iter().fold((self.nodes.len(), self.leaves.len()), |(n, l), link| {
+            let (a, b) = link.part.sizes();
+            (n + a, l + b)
+        })
     }
+}
+
+/// Append `part` (local root reference `root`) and its linked parts to `nodes` and `leaves`,
+/// shifting references; returns the shifted root.
+fn flatten(part: Part, root: u32, nodes: &mut Vec<Node8>, leaves: &mut Vec<[u32; 2]>) -> u32 {
+    let (node_off, leaf_off) = (nodes.len() as u32, leaves.len() as u32);
+    let shift = |c: u32| {
+        if c == EMPTY {
+            c
+        } else if c & LEAF != 0 {
+            LEAF | ((c & !LEAF) + leaf_off)
+        } else {
+            c + node_off
+        }
+    };
+    nodes.extend(part.nodes.into_iter().map(|mut n| {
+        n.child = n.child.map(shift);
+        n
+    }));
+    leaves.extend(part.leaves);
+    for link in part.links {
+        let r = flatten(link.part, link.root, nodes, leaves);
+        nodes[(node_off + link.node) as usize].child[link.slot] = r;
+    }
+    shift(root)
 }
 
 /// Up to eight clusters covering `c`: the one of largest area (with more than `LEAF_SIZE`
@@ -385,10 +408,11 @@ fn open(prims: &mut [Bounds], ids: &mut [u32], c: Cluster, bins: &mut Bins) -> (
     (kids, n)
 }
 
-/// Emit the subtree over cluster `c` (which covers all of `prims`) into `part`: its reference.
-fn emit(part: &mut Part, tris: &[[Vec3; 3]], prims: &mut [Bounds], ids: &mut [u32], c: Cluster, depth: usize) -> u32 {
+/// Emit the subtree over cluster `c` (which covers all of `prims`, starting at position `base`
+/// of the builder's arrays) into `part`: its reference.
+fn emit(part: &mut Part, prims: &mut [Bounds], ids: &mut [u32], c: Cluster, base: usize, depth: usize) -> u32 {
     if c.len() <= LEAF_SIZE {
-        return part.leaf(tris, &ids[c.start..c.end]);
+        return part.leaf(base + c.start, c.len());
     }
     part.depth = part.depth.max(depth);
     let (kids, n) = open(prims, ids, c, &mut part.bins);
@@ -411,32 +435,34 @@ fn emit(part: &mut Part, tris: &[[Vec3; 3]], prims: &mut [Bounds], ids: &mut [u3
             let (p, tail_p) = std::mem::take(&mut rest_p).split_at_mut(k.len());
             let (i, tail_i) = std::mem::take(&mut rest_i).split_at_mut(k.len());
             (rest_p, rest_i) = (tail_p, tail_i);
-            jobs.push((p, i, rebase(k)));
+            jobs.push((p, i, rebase(k), base + k.start));
         }
         let subs: Vec<(Part, u32)> = jobs
             .into_par_iter()
-            .map(|(p, i, k)| {
+            .map(|(p, i, k, b)| {
                 let mut sub = Part::new(k.len());
-                let root = emit(&mut sub, tris, p, i, k, depth + 1);
+                let root = emit(&mut sub, p, i, k, b, depth + 1);
                 (sub, root)
             })
             .collect();
         for (slot, (sub, root)) in subs.into_iter().enumerate() {
-            node.child[slot] = part.append(sub, root);
+            part.depth = part.depth.max(sub.depth);
+            part.links.push(Link { node: index as u32, slot, part: sub, root });
         }
     } else {
         for (slot, k) in kids.iter().enumerate() {
             node.child[slot] =
-                emit(part, tris, &mut prims[k.start..k.end], &mut ids[k.start..k.end], rebase(k), depth + 1);
+                emit(part, &mut prims[k.start..k.end], &mut ids[k.start..k.end], rebase(k), base + k.start, depth + 1);
         }
     }
     part.nodes[index] = node;
     index as u32
 }
 
-/// The BVH over triangles `tris` with boxes `bounds` (which may be padded). None when empty.
-pub fn build(tris: &[[Vec3; 3]], bounds: Vec<Bounds>) -> Option<Bvh8> {
-    if tris.is_empty() {
+/// The BVH over triangles with boxes `bounds` (which may be padded); `triangle(i)` gives the
+/// vertices of triangle `i` for the leaf packets. None when empty.
+pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> [Vec3; 3] + Sync) -> Option<Bvh8> {
+    if bounds.is_empty() {
         return None;
     }
     let mut prims = bounds;
@@ -444,8 +470,25 @@ pub fn build(tris: &[[Vec3; 3]], bounds: Vec<Bounds>) -> Option<Bvh8> {
     let root_cluster = cluster_of(&prims);
     let mut part = Part::new(prims.len());
     // A whole scene of at most LEAF_SIZE triangles is one packet (depth 0); else node 0 is the root.
-    let root = emit(&mut part, tris, &mut prims, &mut ids, root_cluster, 1);
-    Some(Bvh8 { nodes: part.nodes, packets: part.packets, lane_prims: part.lane_prims, root, depth: part.depth })
+    let root = emit(&mut part, &mut prims, &mut ids, root_cluster, 0, 1);
+    drop(prims);
+    let depth = part.depth;
+    let (node_count, leaf_count) = part.sizes();
+    let (mut nodes, mut leaves) = (Vec::with_capacity(node_count), Vec::with_capacity(leaf_count));
+    let root = flatten(part, root, &mut nodes, &mut leaves);
+    let (packets, lane_prims): (Vec<TriPacket4>, Vec<[u32; LEAF_SIZE]>) = leaves
+        .par_iter()
+        .map(|&[start, len]| {
+            let mut packet = TriPacket4::EMPTY;
+            let mut lanes = [u32::MAX; LEAF_SIZE];
+            for (lane, &id) in ids[start as usize..(start + len) as usize].iter().enumerate() {
+                packet.set(lane, triangle(id));
+                lanes[lane] = id;
+            }
+            (packet, lanes)
+        })
+        .unzip();
+    Some(Bvh8 { nodes, packets, lane_prims, root, depth })
 }
 
 #[cfg(test)]
@@ -471,14 +514,14 @@ mod tests {
         for pts in cases {
             let tris: Vec<[Vec3; 3]> = pts.iter().map(|&p| [p, p + Vec3::X * 0.1, p + Vec3::Y * 0.1]).collect();
             let b = boxes(&pts);
-            let bvh = build(&tris, b.clone()).unwrap();
+            let bvh = build(b.clone(), |i| tris[i as usize]).unwrap();
             let mut seen = vec![0u32; pts.len()];
             // (reference, box it must lie in, depth)
             let mut stack = vec![(bvh.root, Bounds { min: Vec3A::NEG_INFINITY, max: Vec3A::INFINITY }, 1)];
             while let Some((r, outer, d)) = stack.pop() {
                 if r & LEAF != 0 {
                     let p = (r & !LEAF) as usize;
-                    for &id in &bvh.lane_prims[4 * p..4 * p + 4] {
+                    for &id in &bvh.lane_prims[p] {
                         if id != u32::MAX {
                             seen[id as usize] += 1;
                             let pb = b[id as usize];
