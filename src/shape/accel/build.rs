@@ -142,11 +142,14 @@ impl Binning {
 }
 
 impl Binning {
-    /// Bin of doubled centroid `c` on one axis: the same float operations as [`Binning::bins`].
+    /// Is doubled centroid `c` in a bin below `first` on `axis`? The same float operations as
+    /// [`Binning::bins`] (whose truncation is monotonic), so binning and partition agree bit for
+    /// bit; NaN is in bin 0, as there.
     #[inline(always)]
-    fn bin(&self, c: Vec3A, axis: usize) -> usize {
-        let x = ((c[axis] - self.origin[axis]) * self.scale[axis]).max(0.0).min((self.count - 1) as f32);
-        x as usize & (BINS - 1)
+    fn below(&self, c: Vec3A, axis: usize, first: usize) -> bool {
+        let i = axis.min(2);
+        let (c, o, s): (&[f32; 3], &[f32; 3], &[f32; 3]) = (c.as_ref(), self.origin.as_ref(), self.scale.as_ref());
+        !((c[i] - o[i]) * s[i] >= first as f32)
     }
 }
 
@@ -253,7 +256,7 @@ fn split(prims: &mut [Bounds], ids: &mut [u32], c: &Cluster, bins: &mut Bins) ->
             while i < j {
                 let b = p[i];
                 let cen = b.centroid2();
-                if binning.bin(cen, axis) < first_right {
+                if binning.below(cen, axis, first_right) {
                     lb.grow(&b);
                     lc.grow_point(cen);
                     i += 1;
