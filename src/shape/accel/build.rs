@@ -3,15 +3,18 @@
 //! and splits the cluster of largest surface area until it has eight (as Embree's builders do,
 //! Wald et al. 2014), each split chosen by the surface area heuristic over 32 bins of the
 //! centroids on every axis (as many bins as triangles in smaller clusters). A cluster of at most
-//! `LEAF_SIZE` triangles becomes one leaf packet.
+//! `LEAF_SIZE` triangles becomes one leaf packet; while a node has free slots, such a cluster is
+//! still split when its halves' boxes are much smaller than its own (see [`open`]).
 //!
 //! The cost of a side is its area times its triangle count (counting leaf packets, ⌈n / 4⌉,
 //! instead made fuller leaves but slower traversal on the statue and the Cornell box). A cluster
 //! whose centroids all coincide is halved by index.
 //!
 //! Parallel (rayon): large clusters are binned in chunks on every thread, and the subtrees below a
-//! large node are built concurrently, each into its own arrays, which are then appended to the
-//! parent's with their indices shifted. The result does not depend on the thread count.
+//! large node are built concurrently, each into its own part; [`flatten`] copies the parts into
+//! one node array at the end. Leaves are ranges of the builder's index array until then; their
+//! packets are made in one parallel pass from the caller's triangles. The result does not depend
+//! on the thread count.
 //!
 //! Node and leaf boxes are exact unions of the (padded) primitive boxes: they come from the
 //! partition pass itself, not from the bins.
@@ -26,6 +29,9 @@ use rayon::prelude::*;
 const BINS: usize = 32;
 /// Clusters at least this large are binned in parallel chunks of this size.
 const PARALLEL_BIN: usize = 1 << 15;
+/// A leaf-sized cluster in a node with a free slot is split when its halves' box areas sum to
+/// less than this fraction of its own.
+const LEAF_SPLIT: f32 = 0.9;
 /// Nodes over at least this many triangles build their subtrees in parallel.
 const PARALLEL_NODE: usize = 1 << 12;
 
@@ -388,23 +394,39 @@ fn flatten(part: Part, root: u32, nodes: &mut Vec<Node8>, leaves: &mut Vec<[u32;
     shift(root)
 }
 
-/// Up to eight clusters covering `c`: the one of largest area (with more than `LEAF_SIZE`
-/// triangles) is split until there are eight or none is left to split. Sorted by position.
+/// Up to eight clusters covering `c`: the one of largest area is split until there are eight or
+/// none is left to split. Clusters of more than `LEAF_SIZE` triangles are always split; a
+/// leaf-sized one (two or more triangles) only when its halves' box areas sum to less than
+/// `LEAF_SPLIT` times its own (a ray then tests fewer triangles for the same node test: on the
+/// Cornell box, walls that would share a room-sized leaf box get their own). Sorted by position.
 fn open(prims: &mut [Bounds], ids: &mut [u32], c: Cluster, bins: &mut Bins) -> ([Cluster; 8], usize) {
     let mut kids = [c; 8];
-    // Half area of each kid, or −1 when it is too small to split.
-    let mut area = [-1.0f32; 8];
-    let splittable = |k: &Cluster| if k.len() > LEAF_SIZE { k.bounds.half_area() } else { -1.0 };
-    area[0] = splittable(&c);
+    // A leaf-sized cluster whose split did not pay is not tried again.
+    let mut tried = [false; 8];
     let mut n = 1;
     while n < 8 {
-        let i = (0..n).fold(0, |b, i| if area[i] > area[b] { i } else { b });
-        if area[i] < 0.0 {
+        let area = |i: usize| {
+            let k = &kids[i];
+            if k.len() > LEAF_SIZE || (k.len() >= 2 && !tried[i]) {
+                k.bounds.half_area()
+            } else {
+                -1.0
+            }
+        };
+        let i = (0..n).fold(0, |b, i| if area(i) > area(b) { i } else { b });
+        if area(i) < 0.0 {
             break;
         }
         let (l, r) = split(prims, ids, &kids[i], bins);
+        if kids[i].len() <= LEAF_SIZE
+            && l.bounds.half_area() + r.bounds.half_area() >= LEAF_SPLIT * kids[i].bounds.half_area()
+        {
+            // The halves keep the cluster's triangles (reordered within its range).
+            tried[i] = true;
+            continue;
+        }
         (kids[i], kids[n]) = (l, r);
-        (area[i], area[n]) = (splittable(&l), splittable(&r));
+        (tried[i], tried[n]) = (false, false);
         n += 1;
     }
     kids[..n].sort_unstable_by_key(|k| k.start);
@@ -463,8 +485,9 @@ fn emit(part: &mut Part, prims: &mut [Bounds], ids: &mut [u32], c: Cluster, base
 }
 
 /// The BVH over triangles with boxes `bounds` (which may be padded); `triangle(i)` gives the
-/// vertices of triangle `i` for the leaf packets. None when empty.
-pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> [Vec3; 3] + Sync) -> Option<Bvh8> {
+/// vertices of triangle `i` for the leaf packets and the (shape, triangle) pair its lane records.
+/// None when empty.
+pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> ([Vec3; 3], (u32, u32)) + Sync) -> Option<Bvh8> {
     if bounds.is_empty() {
         return None;
     }
@@ -479,14 +502,15 @@ pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> [Vec3; 3] + Sync) ->
     let (node_count, leaf_count) = part.sizes();
     let (mut nodes, mut leaves) = (Vec::with_capacity(node_count), Vec::with_capacity(leaf_count));
     let root = flatten(part, root, &mut nodes, &mut leaves);
-    let (packets, lane_prims): (Vec<TriPacket4>, Vec<[u32; LEAF_SIZE]>) = leaves
+    let (packets, lane_prims): (Vec<TriPacket4>, Vec<[(u32, u32); LEAF_SIZE]>) = leaves
         .par_iter()
         .map(|&[start, len]| {
             let mut packet = TriPacket4::EMPTY;
-            let mut lanes = [u32::MAX; LEAF_SIZE];
+            let mut lanes = [(u32::MAX, u32::MAX); LEAF_SIZE];
             for (lane, &id) in ids[start as usize..(start + len) as usize].iter().enumerate() {
-                packet.set(lane, triangle(id));
-                lanes[lane] = id;
+                let (tri, r) = triangle(id);
+                packet.set(lane, tri);
+                lanes[lane] = r;
             }
             (packet, lanes)
         })
@@ -517,14 +541,14 @@ mod tests {
         for pts in cases {
             let tris: Vec<[Vec3; 3]> = pts.iter().map(|&p| [p, p + Vec3::X * 0.1, p + Vec3::Y * 0.1]).collect();
             let b = boxes(&pts);
-            let bvh = build(b.clone(), |i| tris[i as usize]).unwrap();
+            let bvh = build(b.clone(), |i| (tris[i as usize], (0, i))).unwrap();
             let mut seen = vec![0u32; pts.len()];
             // (reference, box it must lie in, depth)
             let mut stack = vec![(bvh.root, Bounds { min: Vec3A::NEG_INFINITY, max: Vec3A::INFINITY }, 1)];
             while let Some((r, outer, d)) = stack.pop() {
                 if r & LEAF != 0 {
                     let p = (r & !LEAF) as usize;
-                    for &id in &bvh.lane_prims[p] {
+                    for &(_, id) in &bvh.lane_prims[p] {
                         if id != u32::MAX {
                             seen[id as usize] += 1;
                             let pb = b[id as usize];

@@ -58,9 +58,6 @@ impl Isa {
 
 pub struct Accel {
     bvh: Option<Bvh8>,
-    /// Per mesh shape in the BVH: (first BVH triangle index, shape index); the BVH numbers the
-    /// triangles of the meshes one after another.
-    mesh_starts: Vec<(u32, u32)>,
     /// Shapes tested outside the BVH (spheres, disks).
     analytic: Vec<u32>,
     isa: Isa,
@@ -75,6 +72,8 @@ impl Accel {
     /// lacks it).
     pub fn build_with(shapes: &[Shape], isa: Isa) -> Accel {
         let isa = if isa == Isa::Avx2 && Isa::detect() != Isa::Avx2 { Isa::Portable } else { isa };
+        // Per mesh: (first builder index, shape index); the builder numbers the triangles of the
+        // meshes one after another.
         let mut mesh_starts = Vec::new();
         let mut bounds = Vec::new();
         let mut analytic = Vec::new();
@@ -100,16 +99,16 @@ impl Accel {
         let bvh = build::build(bounds, |id| {
             let (shape, prim) = shape_prim(&mesh_starts, id);
             match &shapes[shape as usize].geometry {
-                Geometry::Mesh(m) => m.vertices(prim),
+                Geometry::Mesh(m) => (m.vertices(prim), (shape, prim)),
                 _ => unreachable!("only meshes are in the BVH"),
             }
         });
-        Accel { bvh, mesh_starts, analytic, isa }
+        Accel { bvh, analytic, isa }
     }
 
-    /// Bytes of the BVH (nodes, triangle packets, lane and primitive indices).
+    /// Bytes of the BVH (nodes, triangle packets, per-lane shape and triangle).
     pub fn memory_bytes(&self) -> usize {
-        self.bvh.as_ref().map_or(0, |b| b.memory_bytes()) + self.mesh_starts.len() * 8
+        self.bvh.as_ref().map_or(0, |b| b.memory_bytes())
     }
 
     /// BVH nodes, leaf packets and depth.
@@ -134,7 +133,7 @@ impl Accel {
         }
         if let Some(bvh) = &self.bvh {
             if let Some((lane, t, b1, b2)) = self.closest(bvh, ray, tmax) {
-                let (shape, prim) = shape_prim(&self.mesh_starts, bvh.lane_prims[lane as usize / 4][lane as usize % 4]);
+                let (shape, prim) = bvh.lane_prims[lane as usize / 4][lane as usize % 4];
                 best = Some(Hit { shape, prim, b1, b2, t });
             }
         }
@@ -189,7 +188,7 @@ impl Accel {
     }
 }
 
-/// Shape and triangle of BVH triangle `id`.
+/// Shape and triangle of builder index `id`.
 #[inline]
 fn shape_prim(mesh_starts: &[(u32, u32)], id: u32) -> (u32, u32) {
     let k = mesh_starts.partition_point(|m| m.0 <= id) - 1;
