@@ -102,19 +102,11 @@ fn main() {
 
 /// Time the scene-side work for the mesh: world-space mesh (area table, normals) and the BVH.
 fn bvh_build(m: snee::shape::mesh_data::MeshData) {
-    use snee::shape::{accel::Accel, Geometry, Mesh, Shape};
+    use snee::shape::{accel::Accel, Mesh, Shape};
     let t0 = Instant::now();
     let mesh = Mesh::new(m, &snee::math::Mat4::IDENTITY, false, false);
     let t1 = Instant::now();
-    let shape = Shape {
-        geometry: Geometry::Mesh(mesh),
-        plugin: "ply".into(),
-        id: None,
-        bsdf: 0,
-        emitter: None,
-        interior: None,
-        exterior: None,
-    };
+    let shape = Shape::from_mesh(mesh);
     let shapes = [shape];
     let accel = Accel::build(&shapes);
     let t2 = Instant::now();

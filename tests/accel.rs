@@ -5,7 +5,7 @@ use snee::math::{Mat4, Ray, Vec2, Vec3};
 use snee::sampler::Sampler;
 use snee::shape::accel::Accel;
 use snee::shape::mesh_data::MeshData;
-use snee::shape::{Geometry, Mesh, Shape};
+use snee::shape::{Mesh, Shape};
 
 /// Icosphere with `level` subdivisions (20·4^level triangles), shared vertices.
 fn icosphere(level: u32) -> MeshData {
@@ -71,15 +71,7 @@ fn icosphere(level: u32) -> MeshData {
 }
 
 fn shape(data: MeshData, to_world: Mat4) -> Shape {
-    Shape {
-        geometry: Geometry::Mesh(Mesh::new(data, &to_world, true, false)),
-        plugin: "ply".into(),
-        id: None,
-        bsdf: 0,
-        emitter: None,
-        interior: None,
-        exterior: None,
-    }
+    Shape::from_mesh(Mesh::new(data, &to_world, true, false))
 }
 
 #[test]

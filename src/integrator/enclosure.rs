@@ -22,6 +22,7 @@ use crate::emitter::Emitter;
 use crate::math::Aabb;
 use crate::scene::world::{Scene, SceneEmitter};
 use crate::shape::{Geometry, Mesh, Shape};
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Per medium of `scene`: true when emitter sampling from inside it always returns exactly 0.
@@ -82,7 +83,7 @@ fn encloses_inside(s: &Shape) -> bool {
 /// triangle with two corners at one position), else `None`. Closed by vertex index is checked
 /// first (linear time); only a mesh that is not is checked again with vertices welded by position.
 fn closed_signed_volume(mesh: &Mesh) -> Option<f64> {
-    let degenerate = mesh.indices.iter().any(|t| {
+    let degenerate = mesh.indices.par_iter().any(|t| {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize].to_array().map(f32::to_bits));
         a == b || b == c || c == a
     });
@@ -92,9 +93,10 @@ fn closed_signed_volume(mesh: &Mesh) -> Option<f64> {
     if !closed_by_index(&mesh.indices, mesh.positions.len()) && !closed_welded(mesh) {
         return None;
     }
+    // Summed in parallel (the order varies; only the sign is used).
     let volume = mesh
         .indices
-        .iter()
+        .par_iter()
         .map(|tri| {
             let [p0, p1, p2] = tri.map(|i| mesh.positions[i as usize].as_dvec3());
             p0.dot(p1.cross(p2)) / 6.0
@@ -104,7 +106,7 @@ fn closed_signed_volume(mesh: &Mesh) -> Option<f64> {
 }
 
 /// Is every edge of `indices` used exactly once in each direction? Directed edges are bucketed by
-/// their smaller vertex (a counting sort), then each small bucket is sorted and paired.
+/// their smaller vertex (a counting sort), then each small bucket is sorted and paired (in parallel).
 fn closed_by_index(indices: &[[u32; 3]], vertex_count: usize) -> bool {
     if indices.is_empty() {
         return false;
@@ -134,11 +136,35 @@ fn closed_by_index(indices: &[[u32; 3]], vertex_count: usize) -> bool {
             *slot += 1;
         }
     }
-    start.windows(2).all(|w| {
-        let bucket = &mut other[w[0] as usize..w[1] as usize];
-        bucket.sort_unstable();
+    let paired = |bucket: &[u64]| {
         bucket.chunks(2).all(|c| c.len() == 2 && c[0] >> 1 == c[1] >> 1 && c[0] & 1 == 0 && c[1] & 1 == 1)
+    };
+    start.par_windows(2).all(|w| {
+        let bucket = &other[w[0] as usize..w[1] as usize];
+        // Buckets are small (about the vertex valence): sort a copy on the stack.
+        let mut small = [0u64; 16];
+        if let Some(b) = small.get_mut(..bucket.len()) {
+            b.copy_from_slice(bucket);
+            insertion_sort(b);
+            paired(b)
+        } else {
+            let mut b = bucket.to_vec();
+            b.sort_unstable();
+            paired(&b)
+        }
     })
+}
+
+fn insertion_sort(v: &mut [u64]) {
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut j = i;
+        while j > 0 && v[j - 1] > x {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+    }
 }
 
 /// Closedness with vertices welded by position (for meshes that split vertices at seams).

@@ -3,15 +3,18 @@
 //! and splits the cluster of largest surface area until it has eight (as Embree's builders do,
 //! Wald et al. 2014), each split chosen by the surface area heuristic over 32 bins of the
 //! centroids on every axis (as many bins as triangles in smaller clusters). A cluster of at most
-//! `LEAF_SIZE` triangles becomes one leaf packet.
+//! `LEAF_SIZE` triangles becomes one leaf packet; while a node has free slots, such a cluster is
+//! still split when its halves' boxes are much smaller than its own (see [`open`]).
 //!
 //! The cost of a side is its area times its triangle count (counting leaf packets, ⌈n / 4⌉,
 //! instead made fuller leaves but slower traversal on the statue and the Cornell box). A cluster
 //! whose centroids all coincide is halved by index.
 //!
 //! Parallel (rayon): large clusters are binned in chunks on every thread, and the subtrees below a
-//! large node are built concurrently, each into its own arrays, which are then appended to the
-//! parent's with their indices shifted. The result does not depend on the thread count.
+//! large node are built concurrently, each into its own part; [`flatten`] copies the parts into
+//! one node array at the end. Leaves are ranges of the builder's index array until then; their
+//! packets are made in one parallel pass from the caller's triangles. The result does not depend
+//! on the thread count.
 //!
 //! Node and leaf boxes are exact unions of the (padded) primitive boxes: they come from the
 //! partition pass itself, not from the bins.
@@ -26,6 +29,9 @@ use rayon::prelude::*;
 const BINS: usize = 32;
 /// Clusters at least this large are binned in parallel chunks of this size.
 const PARALLEL_BIN: usize = 1 << 15;
+/// A leaf-sized cluster in a node with a free slot is split when its halves' box areas sum to
+/// less than this fraction of its own.
+const LEAF_SPLIT: f32 = 0.9;
 /// Nodes over at least this many triangles build their subtrees in parallel.
 const PARALLEL_NODE: usize = 1 << 12;
 
@@ -141,6 +147,18 @@ impl Binning {
     }
 }
 
+impl Binning {
+    /// Is doubled centroid `c` in a bin below `first` on `axis`? The same float operations as
+    /// [`Binning::bins`] (whose truncation is monotonic), so binning and partition agree bit for
+    /// bit; NaN is in bin 0, as there.
+    #[inline(always)]
+    fn below(&self, c: Vec3A, axis: usize, first: usize) -> bool {
+        let i = axis.min(2);
+        let (c, o, s): (&[f32; 3], &[f32; 3], &[f32; 3]) = (c.as_ref(), self.origin.as_ref(), self.scale.as_ref());
+        !((c[i] - o[i]) * s[i] >= first as f32)
+    }
+}
+
 fn bin_slice(bins: &mut Bins, prims: &[Bounds], binning: &Binning) {
     for p in prims {
         let k = binning.bins(p.centroid2());
@@ -244,7 +262,7 @@ fn split(prims: &mut [Bounds], ids: &mut [u32], c: &Cluster, bins: &mut Bins) ->
             while i < j {
                 let b = p[i];
                 let cen = b.centroid2();
-                if binning.bins(cen)[axis] < first_right {
+                if binning.below(cen, axis, first_right) {
                     lb.grow(&b);
                     lc.grow_point(cen);
                     i += 1;
@@ -304,14 +322,24 @@ fn cluster_of(prims: &[Bounds]) -> Cluster {
     Cluster { start: 0, end: prims.len(), bounds, centroids }
 }
 
-/// Nodes, packets and lane indices of a (sub)tree; child references are local to it.
+/// Nodes and leaves of a (sub)tree; child references are local to it. Subtrees built in
+/// parallel stay separate parts (`links`) until [`flatten`] copies every part once into the tree.
 struct Part {
     nodes: Vec<Node8>,
-    packets: Vec<TriPacket4>,
-    lane_prims: Vec<u32>,
+    /// Per leaf: the first position in the builder's index array and the triangle count.
+    leaves: Vec<[u32; 2]>,
+    /// Subtrees hanging from slot `slot` of local node `node`, with their local root reference.
+    links: Vec<Link>,
     depth: usize,
     /// Scratch bins for the splits.
     bins: Box<Bins>,
+}
+
+struct Link {
+    node: u32,
+    slot: usize,
+    part: Part,
+    root: u32,
 }
 
 impl Part {
@@ -319,76 +347,97 @@ impl Part {
     fn new(n: usize) -> Part {
         Part {
             nodes: Vec::with_capacity(n / 12 + 1),
-            packets: Vec::with_capacity(n / 3 + 1),
-            lane_prims: Vec::with_capacity(4 * (n / 3 + 1)),
+            leaves: Vec::with_capacity(n / 3 + 1),
+            links: Vec::new(),
             depth: 0,
             bins: Box::new(EMPTY_BINS),
         }
     }
 
-    fn leaf(&mut self, tris: &[[Vec3; 3]], ids: &[u32]) -> u32 {
-        debug_assert!(!ids.is_empty() && ids.len() <= LEAF_SIZE);
-        let mut packet = TriPacket4::EMPTY;
-        let mut lanes = [u32::MAX; LEAF_SIZE];
-        for (lane, &id) in ids.iter().enumerate() {
-            packet.set(lane, tris[id as usize]);
-            lanes[lane] = id;
-        }
-        self.packets.push(packet);
-        self.lane_prims.extend_from_slice(&lanes);
-        LEAF | (self.packets.len() - 1) as u32
+    fn leaf(&mut self, start: usize, len: usize) -> u32 {
+        debug_assert!(len > 0 && len <= LEAF_SIZE);
+        self.leaves.push([start as u32, len as u32]);
+        LEAF | (self.leaves.len() - 1) as u32
     }
 
-    /// Append `sub` (root reference `root`), shifting its references; returns the shifted root.
-    fn append(&mut self, sub: Part, root: u32) -> u32 {
-        let (node_off, packet_off) = (self.nodes.len() as u32, self.packets.len() as u32);
-        let shift = |c: u32| {
-            if c == EMPTY {
-                c
-            } else if c & LEAF != 0 {
-                LEAF | ((c & !LEAF) + packet_off)
-            } else {
-                c + node_off
-            }
-        };
-        self.nodes.extend(sub.nodes.into_iter().map(|mut n| {
-            n.child = n.child.map(shift);
-            n
-        }));
-        self.packets.extend(sub.packets);
-        self.lane_prims.extend(sub.lane_prims);
-        self.depth = self.depth.max(sub.depth);
-        shift(root)
+    /// Nodes and leaves of this part and all linked ones.
+    fn sizes(&self) -> (usize, usize) {
+        self.links.iter().fold((self.nodes.len(), self.leaves.len()), |(n, l), link| {
+            let (a, b) = link.part.sizes();
+            (n + a, l + b)
+        })
     }
 }
 
-/// Up to eight clusters covering `c`: the one of largest area (with more than `LEAF_SIZE`
-/// triangles) is split until there are eight or none is left to split. Sorted by position.
+/// Append `part` (local root reference `root`) and its linked parts to `nodes` and `leaves`,
+/// shifting references; returns the shifted root.
+fn flatten(part: Part, root: u32, nodes: &mut Vec<Node8>, leaves: &mut Vec<[u32; 2]>) -> u32 {
+    let (node_off, leaf_off) = (nodes.len() as u32, leaves.len() as u32);
+    let shift = |c: u32| {
+        if c == EMPTY {
+            c
+        } else if c & LEAF != 0 {
+            LEAF | ((c & !LEAF) + leaf_off)
+        } else {
+            c + node_off
+        }
+    };
+    nodes.extend(part.nodes.into_iter().map(|mut n| {
+        n.child = n.child.map(shift);
+        n
+    }));
+    leaves.extend(part.leaves);
+    for link in part.links {
+        let r = flatten(link.part, link.root, nodes, leaves);
+        nodes[(node_off + link.node) as usize].child[link.slot] = r;
+    }
+    shift(root)
+}
+
+/// Up to eight clusters covering `c`: the one of largest area is split until there are eight or
+/// none is left to split. Clusters of more than `LEAF_SIZE` triangles are always split; a
+/// leaf-sized one (two or more triangles) only when its halves' box areas sum to less than
+/// `LEAF_SPLIT` times its own (a ray then tests fewer triangles for the same node test: on the
+/// Cornell box, walls that would share a room-sized leaf box get their own). Sorted by position.
 fn open(prims: &mut [Bounds], ids: &mut [u32], c: Cluster, bins: &mut Bins) -> ([Cluster; 8], usize) {
     let mut kids = [c; 8];
-    // Half area of each kid, or −1 when it is too small to split.
-    let mut area = [-1.0f32; 8];
-    let splittable = |k: &Cluster| if k.len() > LEAF_SIZE { k.bounds.half_area() } else { -1.0 };
-    area[0] = splittable(&c);
+    // A leaf-sized cluster whose split did not pay is not tried again.
+    let mut tried = [false; 8];
     let mut n = 1;
     while n < 8 {
-        let i = (0..n).fold(0, |b, i| if area[i] > area[b] { i } else { b });
-        if area[i] < 0.0 {
+        let area = |i: usize| {
+            let k = &kids[i];
+            if k.len() > LEAF_SIZE || (k.len() >= 2 && !tried[i]) {
+                k.bounds.half_area()
+            } else {
+                -1.0
+            }
+        };
+        let i = (0..n).fold(0, |b, i| if area(i) > area(b) { i } else { b });
+        if area(i) < 0.0 {
             break;
         }
         let (l, r) = split(prims, ids, &kids[i], bins);
+        if kids[i].len() <= LEAF_SIZE
+            && l.bounds.half_area() + r.bounds.half_area() >= LEAF_SPLIT * kids[i].bounds.half_area()
+        {
+            // The halves keep the cluster's triangles (reordered within its range).
+            tried[i] = true;
+            continue;
+        }
         (kids[i], kids[n]) = (l, r);
-        (area[i], area[n]) = (splittable(&l), splittable(&r));
+        (tried[i], tried[n]) = (false, false);
         n += 1;
     }
     kids[..n].sort_unstable_by_key(|k| k.start);
     (kids, n)
 }
 
-/// Emit the subtree over cluster `c` (which covers all of `prims`) into `part`: its reference.
-fn emit(part: &mut Part, tris: &[[Vec3; 3]], prims: &mut [Bounds], ids: &mut [u32], c: Cluster, depth: usize) -> u32 {
+/// Emit the subtree over cluster `c` (which covers all of `prims`, starting at position `base`
+/// of the builder's arrays) into `part`: its reference.
+fn emit(part: &mut Part, prims: &mut [Bounds], ids: &mut [u32], c: Cluster, base: usize, depth: usize) -> u32 {
     if c.len() <= LEAF_SIZE {
-        return part.leaf(tris, &ids[c.start..c.end]);
+        return part.leaf(base + c.start, c.len());
     }
     part.depth = part.depth.max(depth);
     let (kids, n) = open(prims, ids, c, &mut part.bins);
@@ -411,32 +460,35 @@ fn emit(part: &mut Part, tris: &[[Vec3; 3]], prims: &mut [Bounds], ids: &mut [u3
             let (p, tail_p) = std::mem::take(&mut rest_p).split_at_mut(k.len());
             let (i, tail_i) = std::mem::take(&mut rest_i).split_at_mut(k.len());
             (rest_p, rest_i) = (tail_p, tail_i);
-            jobs.push((p, i, rebase(k)));
+            jobs.push((p, i, rebase(k), base + k.start));
         }
         let subs: Vec<(Part, u32)> = jobs
             .into_par_iter()
-            .map(|(p, i, k)| {
+            .map(|(p, i, k, b)| {
                 let mut sub = Part::new(k.len());
-                let root = emit(&mut sub, tris, p, i, k, depth + 1);
+                let root = emit(&mut sub, p, i, k, b, depth + 1);
                 (sub, root)
             })
             .collect();
         for (slot, (sub, root)) in subs.into_iter().enumerate() {
-            node.child[slot] = part.append(sub, root);
+            part.depth = part.depth.max(sub.depth);
+            part.links.push(Link { node: index as u32, slot, part: sub, root });
         }
     } else {
         for (slot, k) in kids.iter().enumerate() {
             node.child[slot] =
-                emit(part, tris, &mut prims[k.start..k.end], &mut ids[k.start..k.end], rebase(k), depth + 1);
+                emit(part, &mut prims[k.start..k.end], &mut ids[k.start..k.end], rebase(k), base + k.start, depth + 1);
         }
     }
     part.nodes[index] = node;
     index as u32
 }
 
-/// The BVH over triangles `tris` with boxes `bounds` (which may be padded). None when empty.
-pub fn build(tris: &[[Vec3; 3]], bounds: Vec<Bounds>) -> Option<Bvh8> {
-    if tris.is_empty() {
+/// The BVH over triangles with boxes `bounds` (which may be padded); `triangle(i)` gives the
+/// vertices of triangle `i` for the leaf packets and the (shape, triangle) pair its lane records.
+/// None when empty.
+pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> ([Vec3; 3], (u32, u32)) + Sync) -> Option<Bvh8> {
+    if bounds.is_empty() {
         return None;
     }
     let mut prims = bounds;
@@ -444,8 +496,26 @@ pub fn build(tris: &[[Vec3; 3]], bounds: Vec<Bounds>) -> Option<Bvh8> {
     let root_cluster = cluster_of(&prims);
     let mut part = Part::new(prims.len());
     // A whole scene of at most LEAF_SIZE triangles is one packet (depth 0); else node 0 is the root.
-    let root = emit(&mut part, tris, &mut prims, &mut ids, root_cluster, 1);
-    Some(Bvh8 { nodes: part.nodes, packets: part.packets, lane_prims: part.lane_prims, root, depth: part.depth })
+    let root = emit(&mut part, &mut prims, &mut ids, root_cluster, 0, 1);
+    drop(prims);
+    let depth = part.depth;
+    let (node_count, leaf_count) = part.sizes();
+    let (mut nodes, mut leaves) = (Vec::with_capacity(node_count), Vec::with_capacity(leaf_count));
+    let root = flatten(part, root, &mut nodes, &mut leaves);
+    let (packets, lane_prims): (Vec<TriPacket4>, Vec<[(u32, u32); LEAF_SIZE]>) = leaves
+        .par_iter()
+        .map(|&[start, len]| {
+            let mut packet = TriPacket4::EMPTY;
+            let mut lanes = [(u32::MAX, u32::MAX); LEAF_SIZE];
+            for (lane, &id) in ids[start as usize..(start + len) as usize].iter().enumerate() {
+                let (tri, r) = triangle(id);
+                packet.set(lane, tri);
+                lanes[lane] = r;
+            }
+            (packet, lanes)
+        })
+        .unzip();
+    Some(Bvh8 { nodes, packets, lane_prims, root, depth })
 }
 
 #[cfg(test)]
@@ -471,14 +541,14 @@ mod tests {
         for pts in cases {
             let tris: Vec<[Vec3; 3]> = pts.iter().map(|&p| [p, p + Vec3::X * 0.1, p + Vec3::Y * 0.1]).collect();
             let b = boxes(&pts);
-            let bvh = build(&tris, b.clone()).unwrap();
+            let bvh = build(b.clone(), |i| (tris[i as usize], (0, i))).unwrap();
             let mut seen = vec![0u32; pts.len()];
             // (reference, box it must lie in, depth)
             let mut stack = vec![(bvh.root, Bounds { min: Vec3A::NEG_INFINITY, max: Vec3A::INFINITY }, 1)];
             while let Some((r, outer, d)) = stack.pop() {
                 if r & LEAF != 0 {
                     let p = (r & !LEAF) as usize;
-                    for &id in &bvh.lane_prims[4 * p..4 * p + 4] {
+                    for &(_, id) in &bvh.lane_prims[p] {
                         if id != u32::MAX {
                             seen[id as usize] += 1;
                             let pb = b[id as usize];

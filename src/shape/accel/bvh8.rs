@@ -39,9 +39,9 @@ impl Node8 {
 pub struct Bvh8 {
     pub nodes: Vec<Node8>,
     pub packets: Vec<TriPacket4>,
-    /// Per packet lane (`4 · packet + lane`): the index of the triangle in the builder's input, or
-    /// `u32::MAX` for an unused lane.
-    pub lane_prims: Vec<u32>,
+    /// Per packet and lane: (shape, triangle) as the builder's caller numbers them, or
+    /// `(u32::MAX, u32::MAX)` for an unused lane.
+    pub lane_prims: Vec<[(u32, u32); LEAF_SIZE]>,
     /// Node 0, or `LEAF | 0` when the whole scene is one packet.
     pub root: u32,
     /// Longest root-to-leaf path in nodes (bounds the traversal stack).
@@ -53,6 +53,6 @@ impl Bvh8 {
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<Node8>()
             + self.packets.len() * std::mem::size_of::<TriPacket4>()
-            + self.lane_prims.len() * 4
+            + self.lane_prims.len() * std::mem::size_of::<[(u32, u32); LEAF_SIZE]>()
     }
 }

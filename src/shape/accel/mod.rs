@@ -22,13 +22,6 @@ use rayon::prelude::*;
 use std::mem::MaybeUninit;
 use traverse::{Stack, STACK};
 
-/// A BVH primitive: triangle `prim` of shape `shape`.
-#[derive(Clone, Copy, Debug)]
-struct PrimRef {
-    shape: u32,
-    prim: u32,
-}
-
 /// Closest hit: shape, primitive, barycentrics of vertices 1 and 2, distance.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
@@ -65,8 +58,6 @@ impl Isa {
 
 pub struct Accel {
     bvh: Option<Bvh8>,
-    /// Shape and triangle of every BVH triangle (indexed by the builder's input order).
-    prims: Vec<PrimRef>,
     /// Shapes tested outside the BVH (spheres, disks).
     analytic: Vec<u32>,
     isa: Isa,
@@ -81,18 +72,17 @@ impl Accel {
     /// lacks it).
     pub fn build_with(shapes: &[Shape], isa: Isa) -> Accel {
         let isa = if isa == Isa::Avx2 && Isa::detect() != Isa::Avx2 { Isa::Portable } else { isa };
-        let mut prims = Vec::new();
+        // Per mesh: (first builder index, shape index); the builder numbers the triangles of the
+        // meshes one after another.
+        let mut mesh_starts = Vec::new();
         let mut bounds = Vec::new();
-        let mut tris = Vec::new();
         let mut analytic = Vec::new();
         for (si, s) in shapes.iter().enumerate() {
             match &s.geometry {
                 Geometry::Mesh(m) => {
-                    prims.extend((0..m.indices.len() as u32).map(|pi| PrimRef { shape: si as u32, prim: pi }));
-                    let vertices = |idx: &[u32; 3]| idx.map(|i| m.positions[i as usize]);
-                    tris.par_extend(m.indices.par_iter().map(vertices));
+                    mesh_starts.push((bounds.len() as u32, si as u32));
                     bounds.par_extend(m.indices.par_iter().map(|idx| {
-                        let va = vertices(idx).map(Vec3A::from);
+                        let va = idx.map(|i| Vec3A::from(m.positions[i as usize]));
                         let mut b = Bounds { min: va[0].min(va[1]).min(va[2]), max: va[0].max(va[1]).max(va[2]) };
                         // Pad the box by a little more than the rounding of the node test, so a
                         // ray through a box corner (a vertex shared by triangles) is never culled.
@@ -106,13 +96,19 @@ impl Accel {
                 _ => analytic.push(si as u32),
             }
         }
-        let bvh = build::build(&tris, bounds);
-        Accel { bvh, prims, analytic, isa }
+        let bvh = build::build(bounds, |id| {
+            let (shape, prim) = shape_prim(&mesh_starts, id);
+            match &shapes[shape as usize].geometry {
+                Geometry::Mesh(m) => (m.vertices(prim), (shape, prim)),
+                _ => unreachable!("only meshes are in the BVH"),
+            }
+        });
+        Accel { bvh, analytic, isa }
     }
 
-    /// Bytes of the BVH (nodes, triangle packets, lane and primitive indices).
+    /// Bytes of the BVH (nodes, triangle packets, per-lane shape and triangle).
     pub fn memory_bytes(&self) -> usize {
-        self.bvh.as_ref().map_or(0, |b| b.memory_bytes()) + self.prims.len() * std::mem::size_of::<PrimRef>()
+        self.bvh.as_ref().map_or(0, |b| b.memory_bytes())
     }
 
     /// BVH nodes, leaf packets and depth.
@@ -137,8 +133,8 @@ impl Accel {
         }
         if let Some(bvh) = &self.bvh {
             if let Some((lane, t, b1, b2)) = self.closest(bvh, ray, tmax) {
-                let pr = self.prims[bvh.lane_prims[lane as usize] as usize];
-                best = Some(Hit { shape: pr.shape, prim: pr.prim, b1, b2, t });
+                let (shape, prim) = bvh.lane_prims[lane as usize / 4][lane as usize % 4];
+                best = Some(Hit { shape, prim, b1, b2, t });
             }
         }
         best
@@ -190,6 +186,13 @@ impl Accel {
         }
         traverse::any_portable(bvh, ray, ray.tmax, stack)
     }
+}
+
+/// Shape and triangle of builder index `id`.
+#[inline]
+fn shape_prim(mesh_starts: &[(u32, u32)], id: u32) -> (u32, u32) {
+    let k = mesh_starts.partition_point(|m| m.0 <= id) - 1;
+    (mesh_starts[k].1, id - mesh_starts[k].0)
 }
 
 /// A traversal stack on the heap, for trees too deep for the fixed one.

@@ -14,15 +14,7 @@ fn soup(seed: u64, count: u32, spread: f32) -> Vec<Shape> {
         data.indices.push([3 * i, 3 * i + 1, 3 * i + 2]);
     }
     let mesh = crate::shape::Mesh::new(data, &crate::math::Mat4::IDENTITY, true, false);
-    vec![Shape {
-        geometry: Geometry::Mesh(mesh),
-        plugin: "ply".into(),
-        id: None,
-        bsdf: 0,
-        emitter: None,
-        interior: None,
-        exterior: None,
-    }]
+    vec![Shape::from_mesh(mesh)]
 }
 
 fn random_ray(s: &mut Sampler, i: usize, spread: f32) -> Ray {

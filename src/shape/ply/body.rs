@@ -126,6 +126,10 @@ pub(super) trait Body {
     fn trailing(&mut self) -> Option<String>;
     /// An error at the current position.
     fn error(&self, file: &str, msg: String) -> Error;
+    /// The unread bytes of a binary little-endian body (for fast paths), else `None`.
+    fn little_endian_rest(&self) -> Option<&[u8]> {
+        None
+    }
 }
 
 pub(super) struct Binary<'a> {
@@ -225,6 +229,10 @@ impl Body for Binary<'_> {
 
     fn error(&self, file: &str, msg: String) -> Error {
         Error::in_file(file, format!("{msg} (byte offset {})", self.base + self.pos))
+    }
+
+    fn little_endian_rest(&self) -> Option<&[u8]> {
+        (!self.big_endian).then(|| self.bytes.get(self.pos..).unwrap_or(&[]))
     }
 }
 
@@ -507,7 +515,8 @@ pub(super) fn read_faces<R: Body>(
     let Some(list) = plan.face_indices else { return skip_element(r, el, file) };
     mesh.indices.reserve_exact(cap);
     let vertex_count = plan.vertex_count;
-    for i in 0..el.count {
+    let first = fast_triangles(r, el, list, vertex_count, mesh);
+    for i in first..el.count {
         for (k, p) in el.props.iter().enumerate() {
             match p.ty {
                 PropType::List { count, item } if k == list => {
@@ -542,4 +551,32 @@ pub(super) fn read_faces<R: Body>(
         }
     }
     Ok(())
+}
+
+/// Fast path of `read_faces` for the common binary layout: little-endian faces whose only property
+/// is a `uchar` count and `int` / `uint` indices. Decodes the leading records that are triangles
+/// with indices in range and returns how many; the generic loop reads the rest (and reports errors).
+fn fast_triangles<R: Body>(r: &mut R, el: &Element, list: usize, vertex_count: u64, mesh: &mut MeshData) -> u64 {
+    const RECORD: usize = 13;
+    let signed = match el.props.as_slice() {
+        [p] => match p.ty {
+            PropType::List { count: Scalar::U8, item: Scalar::I32 } if list == 0 => true,
+            PropType::List { count: Scalar::U8, item: Scalar::U32 } if list == 0 => false,
+            _ => return 0,
+        },
+        _ => return 0,
+    };
+    let Some(bytes) = r.little_endian_rest() else { return 0 };
+    // Largest valid index + 1 as a u32 comparison bound (signed indices stop at i32::MAX).
+    let limit = vertex_count.min(if signed { 1 << 31 } else { 1 << 32 });
+    let records = bytes.len().min(el.count as usize * RECORD) / RECORD;
+    let start = mesh.indices.len();
+    mesh.indices.extend(bytes[..records * RECORD].chunks_exact(RECORD).map_while(|c| {
+        let v = |k: usize| u32::from_le_bytes([c[1 + 4 * k], c[2 + 4 * k], c[3 + 4 * k], c[4 + 4 * k]]);
+        let t = [v(0), v(1), v(2)];
+        (c[0] == 3 && t.iter().all(|&i| u64::from(i) < limit)).then_some(t)
+    }));
+    let done = mesh.indices.len() - start;
+    r.skip_bytes(done * RECORD);
+    done as u64
 }
