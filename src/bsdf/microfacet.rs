@@ -108,7 +108,7 @@ impl MicrofacetDistribution {
             // Azimuth (identical for Beckmann and GGX).
             let (sin_phi, cos_phi, alpha_2);
             if self.is_isotropic() {
-                let (s, c) = (2.0 * PI * sample.y).sin_cos();
+                let (s, c) = crate::math::fast::sincos_2pi(sample.y);
                 sin_phi = s;
                 cos_phi = c;
                 alpha_2 = self.alpha_u * self.alpha_u;

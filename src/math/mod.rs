@@ -3,6 +3,7 @@
 //! Geometry is single precision (as in Mitsuba's `llvm_ad_rgb`); scene descriptions keep
 //! double precision ([`glam::DMat4`]) until the scene is built.
 
+pub mod fast;
 pub mod frame;
 pub mod warp;
 

@@ -1,6 +1,7 @@
 //! Sample warps from the unit square (Mitsuba's `warp` namespace), each with its pdf.
 
-use super::{INV_FOUR_PI, INV_PI, INV_TWO_PI, PI};
+use super::fast::sincos_2pi;
+use super::{INV_FOUR_PI, INV_PI, INV_TWO_PI};
 use glam::{Vec2, Vec3};
 
 /// Uniform on the unit disk, concentric mapping (Shirley & Chiu 1997).
@@ -11,8 +12,10 @@ pub fn square_to_uniform_disk_concentric(s: Vec2) -> Vec2 {
     if x == 0.0 && y == 0.0 {
         return Vec2::ZERO;
     }
-    let (r, phi) = if x * x > y * y { (x, (PI / 4.0) * (y / x)) } else { (y, PI / 2.0 - (PI / 4.0) * (x / y)) };
-    Vec2::new(r * phi.cos(), r * phi.sin())
+    // φ = (π/4)·(y/x), or π/2 − (π/4)·(x/y), as a fraction of a turn.
+    let (r, turns) = if x * x > y * y { (x, 0.125 * (y / x)) } else { (y, 0.25 - 0.125 * (x / y)) };
+    let (sin_phi, cos_phi) = sincos_2pi(turns);
+    Vec2::new(r * cos_phi, r * sin_phi)
 }
 
 /// Cosine-weighted hemisphere around +Z.
@@ -37,8 +40,8 @@ pub fn square_to_cosine_hemisphere_pdf(v: Vec3) -> f32 {
 pub fn square_to_uniform_sphere(s: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * s.y;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * s.x;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin_phi, cos_phi) = sincos_2pi(s.x);
+    Vec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 #[inline]
@@ -51,8 +54,8 @@ pub fn square_to_uniform_sphere_pdf() -> f32 {
 pub fn square_to_uniform_hemisphere(s: Vec2) -> Vec3 {
     let z = s.y;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * s.x;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin_phi, cos_phi) = sincos_2pi(s.x);
+    Vec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 #[inline]
@@ -65,8 +68,8 @@ pub fn square_to_uniform_hemisphere_pdf() -> f32 {
 pub fn square_to_uniform_cone(s: Vec2, cos_cutoff: f32) -> Vec3 {
     let cos_theta = (1.0 - s.y) + s.y * cos_cutoff;
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let phi = 2.0 * PI * s.x;
-    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+    let (sin_phi, cos_phi) = sincos_2pi(s.x);
+    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
 }
 
 #[inline]
@@ -89,8 +92,8 @@ pub fn square_to_uniform_triangle(s: Vec2) -> Vec2 {
 #[inline]
 pub fn square_to_std_normal(s: Vec2) -> Vec2 {
     let r = (-2.0 * (1.0 - s.x).ln()).sqrt();
-    let phi = 2.0 * PI * s.y;
-    Vec2::new(r * phi.cos(), r * phi.sin())
+    let (sin_phi, cos_phi) = sincos_2pi(s.y);
+    Vec2::new(r * cos_phi, r * sin_phi)
 }
 
 #[cfg(test)]

@@ -68,9 +68,9 @@ impl Homogeneous {
     }
 
     /// Transmittance over distance `t`.
-    #[inline]
+    #[inline(always)]
     pub fn transmittance(&self, t: f32) -> Spectrum {
-        (-self.sigma_t * t).exp()
+        crate::math::fast::exp3(-self.sigma_t * t)
     }
 
     #[inline]

@@ -67,8 +67,8 @@ impl Phase {
                     ((1.0 + g * g - sqr * sqr) / (2.0 * g)).clamp(-1.0, 1.0)
                 };
                 let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let phi = 2.0 * std::f32::consts::PI * sample.y;
-                let local = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
+                let (sin_phi, cos_phi) = crate::math::fast::sincos_2pi(sample.y);
+                let local = Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta);
                 let wo = Frame::from_normal(-wi).to_world(local);
                 (wo, 1.0, hg(cos_theta, g))
             }

@@ -104,7 +104,7 @@ impl ImageBlock {
 
         let radius = match self.kernel {
             FilterKernel::Box => {
-                let (x, y) = ((pos.x.floor() as i64).saturating_sub(ox), (pos.y.floor() as i64).saturating_sub(oy));
+                let (x, y) = (floor_i64(pos.x).saturating_sub(ox), floor_i64(pos.y).saturating_sub(oy));
                 if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
                     return;
                 }
@@ -120,10 +120,10 @@ impl ImageBlock {
         };
 
         // Pixels i with centre i + 0.5 within the radius of pos, clipped to the storage.
-        let x0 = ((pos.x - 0.5 - radius).ceil() as i64).max(ox);
-        let x1 = ((pos.x - 0.5 + radius).floor() as i64).min(ox + w as i64 - 1);
-        let y0 = ((pos.y - 0.5 - radius).ceil() as i64).max(oy);
-        let y1 = ((pos.y - 0.5 + radius).floor() as i64).min(oy + h as i64 - 1);
+        let x0 = ceil_i64(pos.x - 0.5 - radius).max(ox);
+        let x1 = floor_i64(pos.x - 0.5 + radius).min(ox + w as i64 - 1);
+        let y0 = ceil_i64(pos.y - 0.5 - radius).max(oy);
+        let y1 = floor_i64(pos.y - 0.5 + radius).min(oy + h as i64 - 1);
         if x0 > x1 || y0 > y1 {
             return;
         }
@@ -136,16 +136,22 @@ impl ImageBlock {
         }
         let mut weights_x = [0.0f32; MAX_CACHED_TAPS];
         let mut weights_y = [0.0f32; MAX_CACHED_TAPS];
-        kernel.eval_taps(x0, pos.x, &mut weights_x[..count_x]);
-        kernel.eval_taps(y0, pos.y, &mut weights_y[..count_y]);
-        let weights_x = &weights_x[..count_x];
-        let weights_y = &weights_y[..count_y];
+        let taps;
+        let (weights_x, weights_y) = if count_x <= 8 && count_y <= 8 {
+            // Both axes in one 16-lane evaluation (the Gaussian's footprint is 4–5 taps per axis).
+            taps = kernel.eval_taps_xy((x0, pos.x), (y0, pos.y));
+            (&taps[..count_x], &taps[8..8 + count_y])
+        } else {
+            kernel.eval_taps(x0, pos.x, &mut weights_x[..count_x]);
+            kernel.eval_taps(y0, pos.y, &mut weights_y[..count_y]);
+            (&weights_x[..count_x], &weights_y[..count_y])
+        };
         let first = ((y0 - oy) as usize * w + (x0 - ox) as usize) * stride;
         let row_stride = w * stride;
         // Fixed channel counts let the compiler unroll the per-pixel loop (RGB + alpha, with moments).
         match self.channels {
-            3 => accumulate::<3>(&mut self.data[first..], row_stride, values, weights_x, weights_y),
-            4 => accumulate::<4>(&mut self.data[first..], row_stride, values, weights_x, weights_y),
+            4 => accumulate4(&mut self.data[first..], row_stride, values, weights_x, weights_y),
+            3 => accumulate3(&mut self.data[first..], row_stride, values, weights_x, weights_y),
             7 => accumulate::<7>(&mut self.data[first..], row_stride, values, weights_x, weights_y),
             _ => {
                 for (j, &wy) in weights_y.iter().enumerate() {
@@ -268,9 +274,89 @@ fn accumulate<const N: usize>(data: &mut [f32], row_stride: usize, values: &[f32
     }
 }
 
+/// `v.floor() as i64` for finite `v` without a libm call (no SSE4.1 `roundss` in the baseline):
+/// truncate, then step down when truncation rounded up (negative non-integers).
+#[inline(always)]
+fn floor_i64(v: f32) -> i64 {
+    let i = v as i64;
+    i - ((i as f32) > v) as i64
+}
+
+/// `v.ceil() as i64` for finite `v` (see [`floor_i64`]).
+#[inline(always)]
+fn ceil_i64(v: f32) -> i64 {
+    let i = v as i64;
+    i + ((i as f32) < v) as i64
+}
+
+/// `px[0..4] += v · weight` as one 4-lane multiply-add (the same products and sums as the scalar
+/// loop, so the same bits).
+#[inline(always)]
+fn add4(px: &mut [f32], v: glam::Vec4, weight: f32) {
+    let px: &mut [f32; 4] = (&mut px[..4]).try_into().expect("four lanes");
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE is part of x86_64; `px` holds four f32 (unaligned loads and stores).
+    unsafe {
+        use std::arch::x86_64::*;
+        let sum = _mm_add_ps(_mm_loadu_ps(px.as_ptr()), _mm_mul_ps(v.into(), _mm_set1_ps(weight)));
+        _mm_storeu_ps(px.as_mut_ptr(), sum);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        *px = (glam::Vec4::from_array(*px) + v * weight).to_array();
+    }
+}
+
+/// [`accumulate`] for RGB (the common film): a pixel's three values and its weight are four
+/// adjacent floats, updated by one 4-lane multiply-add with `(r, g, b, 1)`.
+#[inline]
+fn accumulate3(data: &mut [f32], row_stride: usize, values: &[f32], wxs: &[f32], wys: &[f32]) {
+    let Ok(&[r, g, b]) = <&[f32; 3]>::try_from(values) else { return };
+    let v = glam::Vec4::new(r, g, b, 1.0);
+    let n = wxs.len();
+    for (j, &wy) in wys.iter().enumerate() {
+        if wy == 0.0 {
+            continue;
+        }
+        let start = j * row_stride;
+        let row = &mut data[start..start + n * 4];
+        for (px, &wx) in row.chunks_exact_mut(4).zip(wxs) {
+            add4(px, v, wx * wy);
+        }
+    }
+}
+
+/// [`accumulate`] for RGB + alpha: the four values as one 4-lane multiply-add, then the weight.
+#[inline]
+fn accumulate4(data: &mut [f32], row_stride: usize, values: &[f32], wxs: &[f32], wys: &[f32]) {
+    let Ok(values) = <&[f32; 4]>::try_from(values) else { return };
+    let v = glam::Vec4::from_array(*values);
+    let n = wxs.len();
+    for (j, &wy) in wys.iter().enumerate() {
+        if wy == 0.0 {
+            continue;
+        }
+        let start = j * row_stride;
+        let row = &mut data[start..start + n * 5];
+        for (px, &wx) in row.chunks_exact_mut(5).zip(wxs) {
+            let weight = wx * wy;
+            add4(px, v, weight);
+            px[4] += weight;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_and_ceil_without_libm() {
+        for v in [-3.5f32, -3.0, -0.25, -0.0, 0.0, 0.25, 1.0, 2.999_999_8, 1e7 + 0.5, -1e7 - 0.5, 16_777_216.0] {
+            assert_eq!(floor_i64(v), v.floor() as i64, "floor({v})");
+            assert_eq!(ceil_i64(v), v.ceil() as i64, "ceil({v})");
+        }
+    }
 
     #[test]
     fn box_puts_into_containing_pixel() {

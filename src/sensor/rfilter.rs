@@ -197,6 +197,38 @@ impl FilterKernel {
     }
 }
 
+impl FilterKernel {
+    /// The taps of both axes at once: lanes 0..8 are `eval_taps(first_x, pos_x)` for 8 pixels,
+    /// lanes 8..16 `eval_taps(first_y, pos_y)` (same bits; one vectorised evaluation per sample).
+    #[inline]
+    pub fn eval_taps_xy(&self, (first_x, pos_x): (i64, f32), (first_y, pos_y): (i64, f32)) -> [f32; 16] {
+        let mut out = [0.0f32; 16];
+        if let FilterKernel::Gaussian { coeff, .. } = self {
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("fma") {
+                // SAFETY: the CPU supports FMA (checked just above).
+                unsafe { gaussian_taps_xy_fma(first_x as f32, pos_x, first_y as f32, pos_y, coeff, &mut out) };
+                return out;
+            }
+        }
+        self.eval_taps(first_x, pos_x, &mut out[..8]);
+        self.eval_taps(first_y, pos_y, &mut out[8..]);
+        out
+    }
+}
+
+/// [`gaussian_taps_fma`] for 8 taps of each axis, a fixed width the compiler vectorises whole.
+/// `first_*` are pixel indices (exact in `f32` on any film), so `(first + i) + 0.5 - pos` is
+/// computed as `eval_taps` does.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+fn gaussian_taps_xy_fma(first_x: f32, pos_x: f32, first_y: f32, pos_y: f32, coeff: &[f32; 10], out: &mut [f32; 16]) {
+    for (i, o) in out.iter_mut().enumerate() {
+        let (first, pos) = if i < 8 { (first_x, pos_x) } else { (first_y, pos_y) };
+        *o = estrin10_fma((first + (i & 7) as f32) + 0.5 - pos, coeff).max(0.0);
+    }
+}
+
 /// Coefficients of the Gaussian's polynomial in `x²` for a standard deviation, with the constant
 /// term shifted so that the polynomial is 0 at the radius `4·stddev` (as Mitsuba computes them).
 fn gaussian_coeffs(stddev: f32) -> [f32; 10] {
@@ -321,6 +353,9 @@ mod tests {
             let mut out = [0.0];
             FilterKernel::exact(&RFilter::default()).eval_taps(0, 0.5 - x, &mut out);
             assert_eq!(out[0].to_bits(), bits, "eval_taps at {x}");
+            let taps = FilterKernel::exact(&RFilter::default()).eval_taps_xy((0, 0.5 - x), (-1, 0.5 - x));
+            assert_eq!(taps[0].to_bits(), bits, "eval_taps_xy (x) at {x}");
+            assert_eq!(taps[9].to_bits(), bits, "eval_taps_xy (y) at {x}");
         }
     }
 }
