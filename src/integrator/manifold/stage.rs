@@ -7,6 +7,7 @@
 //! | real scatter `p` in a medium | [`ManifoldStage::at_scatter`] | `x_j = p`; one connection through the flat boundary, MIS-weighted against SNEE run at the previous vertex `x_i` (`manifold::sample`) |
 //! | the ray reaches a surface    | [`ManifoldStage::at_surface`] | takes the pending suffix `x_j → x_k → …` the ray carries ([`Tracker::surface_event`]) |
 //! | an emitter is hit            | [`ManifoldStage::weight`]     | the MIS weight of an escape right after leaving `x_j`'s medium (`manifold::forward_weight`) |
+//! | emitter sampling at `x_k`    | [`ManifoldStage::nee_weight`] | the MIS weight of forward NEE at a rough `x_k` right after `x_j` (`rough::nee_weight`) |
 //! | BSDF sampling at a surface   | [`ManifoldStage::after_bsdf`] | starts or carries the pending suffix ([`Tracker::after_bsdf`]) |
 //!
 //! SNEE's side of the MIS (a SNEE sample the connection could also have made) is one call in
@@ -18,8 +19,9 @@ use crate::bsdf::BsdfSample;
 use crate::color::Spectrum;
 use crate::integrator::cx::Cx;
 use crate::integrator::cx::Scatter;
-use crate::integrator::snee::{Snee, SneeStage};
+use crate::integrator::snee::{Snee, SneeStage, SneeVertex};
 use crate::integrator::stats::LocalStats;
+use crate::interaction::DirectionSample;
 use crate::interaction::SurfaceInteraction;
 use crate::math::Vec3;
 use crate::scene::world::Scene;
@@ -34,6 +36,8 @@ pub struct ManifoldStage<'a> {
     arrived: Option<Pending>,
     /// The surface the current ray reached (`None`: it escaped, an environment hit).
     hit: Option<SurfaceInteraction>,
+    /// The SNEE vertex `x_i` just before the last medium vertex `x_j`, if any.
+    x_i: Option<SneeVertex>,
 }
 
 impl<'a> ManifoldStage<'a> {
@@ -44,6 +48,7 @@ impl<'a> ManifoldStage<'a> {
             tracker: Tracker::default(),
             arrived: None,
             hit: None,
+            x_i: None,
         })
     }
 
@@ -51,7 +56,23 @@ impl<'a> ManifoldStage<'a> {
     /// one connection. Returns its contribution.
     #[inline]
     pub fn at_scatter(&mut self, cx: &mut Cx, snee: &SneeStage, v: &Scatter) -> Spectrum {
+        self.x_i = snee.chain_x_i().copied();
         self.tracker.sample(cx, self.snee.options, snee.chain_x_i(), v)
+    }
+
+    /// The weight of forward NEE towards `ds` at the current surface, when it is a rough `x_k`
+    /// reached right after the medium vertex `x_j` (the manifold connection shares the path);
+    /// `None`: the caller's weight stands.
+    #[inline]
+    pub fn nee_weight(
+        &self,
+        scene: &Scene,
+        ds: &DirectionSample,
+        channel: usize,
+        stats: &mut LocalStats,
+    ) -> Option<f32> {
+        let (x_j, si_k) = (self.tracker.x_j.as_ref()?, self.hit.as_ref()?);
+        super::rough::nee_weight(scene, self.snee.options, self.x_i.as_ref(), x_j, si_k, ds, channel, stats)
     }
 
     /// The ray reached a surface (`None`: it escaped).
