@@ -25,7 +25,7 @@ import tempfile
 
 import common
 
-SNEE = os.path.join(common.ROOT, "target", "release", "snee")
+SNEE = os.environ.get("SNEE", os.path.join(common.ROOT, "target", "release", "snee"))
 
 
 def boundary(alpha):

@@ -387,7 +387,7 @@ pub fn nee_weight(
     channel: usize,
     stats: &mut LocalStats,
 ) -> Option<f32> {
-    if !(ds.delta && !ds.dist.is_finite()) {
+    if !ds.delta || ds.dist.is_finite() {
         return None;
     }
     let rb = boundary_of(scene, x_j.medium)?;
@@ -414,7 +414,7 @@ pub fn snee_weight(
     light: &LightSample,
     channel: usize,
 ) -> Option<f64> {
-    if !(light.delta && !light.dist.is_finite()) {
+    if !light.delta || light.dist.is_finite() {
         return None;
     }
     let si_k = &s.si_k;
