@@ -9,6 +9,8 @@
 //!   batches, Šidák at family-wise 1 %);
 //! - the thick rough slab (GGX α = 0.2, n = 1.33, albedo 0.8) of `scripts/roughness_sweep.py`
 //!   read by an irradiancemeter: `complete` against `volpath`, per-seed Welch test;
+//! - the rough glass cube (GGX α = 0.1) under an environment map (hidden): the same comparison,
+//!   where forward BSDF sampling out of `x_k` is a fourth technique;
 //! - `connection = paper` never runs the connection on a rough boundary (no attempt counted).
 //!
 //! Sample counts chosen before the first run (from the render speed only): cube `volpath`
@@ -47,6 +49,21 @@ fn rough_ggx_cube_agrees_with_volpath() {
 #[test]
 fn rough_beckmann_cube_agrees_with_volpath() {
     cube_agrees_with_volpath(&rough("beckmann", 0.1, 1.5), 80_000);
+}
+
+/// Under an environment (hidden from the camera) the connection shares the suffix with forward
+/// BSDF sampling out of the rough `x_k` too: four techniques. 12 × 128 spp each (as the smooth
+/// envmap test of `manifold_unbiased.rs`), chosen before the first run.
+#[test]
+fn rough_cube_under_envmap_agrees_with_volpath() {
+    let env = r#"<emitter type="envmap"><string name="filename" value="textures/sky.exr"/></emitter>"#;
+    let bsdf = rough("ggx", 0.1, 1.5);
+    let hidden = r#"<boolean name="hide_emitters" value="true"/>"#;
+    let cube = |integrator: &str, extra: &str| common::medium_cube(integrator, &format!("{hidden}{extra}"), &bsdf, env);
+    let volpath = render_batches(&scene(&cube("volpath", ""), &[]), 12, 128, 8, 90_000);
+    let mis = render_batches(&scene(&cube("volpath_snee", COMPLETE), &[]), 12, 128, 8, 90_100);
+    let fwd = render_batches(&scene(&cube("volpath_snee", COMPLETE_FORWARD), &[]), 12, 128, 8, 90_200);
+    common::assert_complete_agrees(&volpath, &mis, &fwd);
 }
 
 fn slab(integrator: &str, extra: &str) -> String {

@@ -1,6 +1,6 @@
 //! Manifold NEE through a flat ROUGH boundary (`roughdielectric`, GGX or Beckmann, isotropic, any
-//! `alpha`): from a medium vertex `x_j`, connect to a DIRECTIONAL light through a microfacet
-//! refraction at the boundary (docs/manifold.md §7).
+//! `alpha`): from a medium vertex `x_j`, connect to a DIRECTIONAL light or the ENVIRONMENT through a
+//! microfacet refraction at the boundary (docs/manifold.md §7).
 //!
 //! On a flat facet the interface looks the same everywhere, so the inner direction can be sampled
 //! from the light side without knowing where `x_k` is: `omega_in ~ bsdf.sample` with `wi = omega_l`
@@ -10,21 +10,24 @@
 //! `omega_jk` (solid angle at `x_j`) is
 //!
 //! ```text
-//! p_man = p_sel · p_imp(omega_in | omega_l)          (p_imp = bsdf.pdf in importance mode)
+//! p_man = p_light · p_imp(omega_in | omega_l)        (p_imp = bsdf.pdf in importance mode)
 //! ```
+//!
+//! (`p_light`: `p_sel` for a directional light, `p_env(omega_l)` for the environment, whose
+//! densities are then also per solid angle of `omega_l`)
 //!
 //! and the estimate `f_p(wi_j, ω_jk) T(d_jk) f_s(x_k; ω_kj → ω_l) tr_light · E / p_man`, with
 //! `f_s` Mitsuba's radiance-mode `eval` (cosine of `ω_l` included). Every plane orientation of the
 //! boundary gets its own sample (the sets of paths through different orientations are disjoint).
 //! The competitors for the same suffix `x_j → x_k → light`, in the same measure ([`rough_pdfs`]):
-//! forward NEE at `x_k` (`f_p e^{−σ_t d_jk} p_sel`), forward BSDF sampling (0: a delta light
-//! cannot be hit) and SNEE from the vertex `x_i` before `x_j` (its `dV(x_j) dA(x_k)` density over
+//! forward NEE at `x_k` (`f_p e^{−σ_t d_jk} p_light`), forward BSDF sampling (`f_p e^{−σ_t d_jk}
+//! bsdf.pdf(ω_kj → ω_l)`, 0 for a delta light, [`bsdf_hit_weight`]) and SNEE from the vertex `x_i` before `x_j` (its `dV(x_j) dA(x_k)` density over
 //! forward's density of `x_j` and `dA(x_k)/dω_jk`). The power heuristic over the four,
 //! [`rough_weight`], is computed by the same function at the three places that make such a
 //! suffix: this connection ([`sample`]), forward NEE at `x_k` ([`nee_weight`], through the
 //! manifold stage) and SNEE ([`snee_weight`], through `manifold::snee_weight`).
 //!
-//! Scope: directional lights only (environments, area and point lights through a rough boundary
+//! Scope: directional lights and the environment (area and point lights through a rough boundary
 //! keep the paper's estimator: the connection contributes nothing for them, so its density is 0
 //! and their weights are unchanged); isotropic roughness (the plane's frame then does not matter).
 
@@ -220,7 +223,7 @@ pub fn rough_pdfs(
         let si_kj = with_wi(si_k, -omega_jk);
         fwd * bsdf.pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l)) as f64
     };
-    let manifold = if light.delta && !light.dist.is_finite() {
+    let manifold = if !light.dist.is_finite() {
         light.p_light as f64 * pdf_inner(bsdf, plane.n, light.omega_l, omega_jk)
     } else {
         0.0
@@ -346,13 +349,18 @@ pub fn sample(
     }
     stats.manifold_attempts += 1;
     let (ds, weight) = scene.sample_emitter_direction(v.p, None, u, false);
-    let directional = ds.pdf > 0.0 && ds.delta && !ds.dist.is_finite() && weight != Spectrum::ZERO;
+    // A directional light or the environment (infinitely far: omega_l is the same at every x_k).
+    let distant = ds.pdf > 0.0
+        && !ds.dist.is_finite()
+        && weight != Spectrum::ZERO
+        && (ds.delta || scene.environment == Some(ds.emitter));
     let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
-    let light = LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: true, le: Spectrum::ZERO };
+    let light =
+        LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: ds.delta, le: Spectrum::ZERO };
     let mut result = Spectrum::ZERO;
     for plane in &rb.planes {
         let (u1, u2) = (sampler.next_1d(), sampler.next_2d());
-        if !directional {
+        if !distant {
             continue;
         }
         let Some(c) = connect(scene, &x_j, plane, ds.d, u1, u2, stats) else { continue };
@@ -362,7 +370,7 @@ pub fn sample(
         if !(w > 0.0) {
             continue;
         }
-        // E / p_sel (weight) · w / p_imp, with p_man = p_sel · p_imp.
+        // E / p_sel or L / p_env (weight) · w / p_imp, with p_man = p_light · p_imp.
         let contribution = v.beta * c.f * weight * (w * ds.pdf as f64 / p.manifold) as f32;
         if crate::color::is_finite(contribution) {
             result += contribution;
@@ -387,7 +395,7 @@ pub fn nee_weight(
     channel: usize,
     stats: &mut LocalStats,
 ) -> Option<f32> {
-    if !ds.delta || ds.dist.is_finite() {
+    if ds.dist.is_finite() || !(ds.delta || scene.environment == Some(ds.emitter)) {
         return None;
     }
     let rb = boundary_of(scene, x_j.medium)?;
@@ -414,7 +422,7 @@ pub fn snee_weight(
     light: &LightSample,
     channel: usize,
 ) -> Option<f64> {
-    if !light.delta || light.dist.is_finite() {
+    if light.dist.is_finite() || !(light.delta || scene.environment.is_some()) {
         return None;
     }
     let si_k = &s.si_k;
@@ -433,6 +441,50 @@ pub fn snee_weight(
     let mut no_rays = LocalStats::default();
     let p = rough_pdfs(scene, opts, Some(&s.x_i), &x_j, path, plane, light, channel, false, &mut no_rays);
     Some(rough_weight(opts, RoughTechnique::Snee, p))
+}
+
+/// A forward path that refracted out through a rough plane at `x_k` right after the medium vertex
+/// `x_j` (`x_i`: the SNEE vertex before `x_j`, if any), until it escapes to the environment
+/// (carried across passable surfaces only, as the connection's light segment).
+#[derive(Clone, Copy, Debug)]
+pub struct RoughPending {
+    pub x_i: Option<SneeVertex>,
+    pub x_j: MediumVertex,
+    /// `x_k`, its `wi` pointing back to `x_j` along the path.
+    pub si_k: SurfaceInteraction,
+    pub plane: RoughPlane,
+}
+
+/// The pending suffix when BSDF sampling at `s` (reached right after `x_j`) refracted out through a
+/// rough plane of `x_j`'s boundary; `None` otherwise.
+pub fn pending(
+    scene: &Scene,
+    x_i: Option<SneeVertex>,
+    x_j: MediumVertex,
+    s: &SurfaceInteraction,
+) -> Option<RoughPending> {
+    let rb = boundary_of(scene, x_j.medium)?;
+    let plane = *rb.plane_at(s.n, scene.shapes[s.shape as usize].bsdf)?;
+    let omega_jk = -s.to_world(s.wi);
+    on_plane(scene, s, x_j.medium, omega_jk, &plane).then_some(RoughPending { x_i, x_j, si_k: *s, plane })
+}
+
+/// The weight of forward BSDF sampling for a path that left through a rough plane right after `x_j`
+/// and escaped along `omega_l` to the environment; `None` without an environment.
+pub fn bsdf_hit_weight(
+    scene: &Scene,
+    opts: SneeOptions,
+    rp: &RoughPending,
+    omega_l: Vec3,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<f32> {
+    let light = super::mis::env_light(scene, &rp.si_k, omega_l)?;
+    let omega_jk = -rp.si_k.to_world(rp.si_k.wi).normalize();
+    let d_jk = (rp.si_k.p - rp.x_j.p).length();
+    let path = (&rp.si_k, omega_jk, d_jk);
+    let p = rough_pdfs(scene, opts, rp.x_i.as_ref(), &rp.x_j, path, &rp.plane, &light, channel, true, stats);
+    Some(rough_weight(opts, RoughTechnique::FwdBsdf, p) as f32)
 }
 
 #[cfg(test)]

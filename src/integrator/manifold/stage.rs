@@ -13,12 +13,14 @@
 //! SNEE's side of the MIS (a SNEE sample the connection could also have made) is one call in
 //! `snee/sample.rs` (`manifold::snee_weight`).
 
+use super::rough::RoughPending;
 use super::track::{Pending, Tracker};
 use super::{forward_weight, Connection};
-use crate::bsdf::BsdfSample;
+use crate::bsdf::{flags, BsdfSample};
 use crate::color::Spectrum;
 use crate::integrator::cx::Cx;
 use crate::integrator::cx::Scatter;
+use crate::integrator::snee::passable;
 use crate::integrator::snee::{Snee, SneeStage, SneeVertex};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::DirectionSample;
@@ -38,6 +40,10 @@ pub struct ManifoldStage<'a> {
     hit: Option<SurfaceInteraction>,
     /// The SNEE vertex `x_i` just before the last medium vertex `x_j`, if any.
     x_i: Option<SneeVertex>,
+    /// A path that left through a rough plane right after `x_j` (`rough.rs`): as the ray leaving the
+    /// last surface carries it, and as it was when the ray reached the current surface.
+    rough_pending: Option<RoughPending>,
+    rough_arrived: Option<RoughPending>,
 }
 
 impl<'a> ManifoldStage<'a> {
@@ -49,6 +55,8 @@ impl<'a> ManifoldStage<'a> {
             arrived: None,
             hit: None,
             x_i: None,
+            rough_pending: None,
+            rough_arrived: None,
         })
     }
 
@@ -79,6 +87,7 @@ impl<'a> ManifoldStage<'a> {
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.arrived = self.tracker.surface_event();
+        self.rough_arrived = self.rough_pending.take();
         self.hit = si.copied();
     }
 
@@ -93,6 +102,13 @@ impl<'a> ManifoldStage<'a> {
         channel: usize,
         stats: &mut LocalStats,
     ) -> Option<f32> {
+        if let Some(rp) = &self.rough_arrived {
+            // Through a rough plane: only an escape to the environment is shared.
+            return match self.hit {
+                None => super::rough::bsdf_hit_weight(scene, self.snee.options, rp, d, channel, stats),
+                Some(_) => None,
+            };
+        }
         let opts = Some(self.snee.options);
         forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.hit.as_ref(), d, channel, stats)
     }
@@ -100,6 +116,14 @@ impl<'a> ManifoldStage<'a> {
     /// BSDF sampling at `s` chose `bs` towards `wo`.
     #[inline]
     pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
+        let non_null = bs.sampled_type & flags::NULL == 0;
+        self.rough_pending = if non_null && bs.sampled_type & flags::TRANSMISSION != 0 && wo.dot(s.n) > 0.0 {
+            self.tracker.x_j.and_then(|x_j| super::rough::pending(scene, self.x_i, x_j, s))
+        } else if !non_null && passable(scene, s) {
+            self.rough_arrived.take()
+        } else {
+            None
+        };
         self.tracker.after_bsdf(scene, s, bs.sampled_type, wo, self.arrived.take());
     }
 }
