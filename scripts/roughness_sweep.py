@@ -6,10 +6,15 @@ paths deep) behind a dielectric boundary (n = 1.33) of GGX roughness alpha in {0
 null quad above it (the scene of tests/transport/snee_slab.rs with n = 1.33).
 
     python3 scripts/roughness_sweep.py [--spp 8192] [--seeds 8] [--threads 2] [--rate R]
+        [--connection paper|complete] [--integrators volpath,volpath_snee] [--alphas 0.2,0.04,0.01,0.001,smooth]
+        [--no-surface]
 
 Prints one table row per integrator: the relative std of the meter's reading across seeds (std /
 mean of the seeds' readings), and the mean reading. volpath reads exactly 0 behind the smooth
-boundary ("black"). volpath_snee runs with its default SNEE rate unless --rate is given.
+boundary ("black"). volpath_snee runs with its default SNEE rate unless --rate is given, and with
+the given `connection` (default `paper`; `complete` adds manifold NEE, docs/manifold.md).
+With --no-surface also the reading without the transport class `surface` (paths with no medium
+vertex: the glint of the light on the rough top face, docs/classes.md), rendered with --classes.
 """
 import argparse
 import json
@@ -20,7 +25,7 @@ import tempfile
 
 import common
 
-SNEE = os.path.join(common.ROOT, "target", "release", "snee")
+SNEE = os.environ.get("SNEE", os.path.join(common.ROOT, "target", "release", "snee"))
 
 
 def boundary(alpha):
@@ -30,8 +35,10 @@ def boundary(alpha):
             f'<float name="alpha" value="{alpha}"/><float name="int_ior" value="1.33"/></bsdf>')
 
 
-def scene(integrator, alpha, spp, rate):
+def scene(integrator, alpha, spp, rate, connection="paper"):
     extra = f'<float name="snee_rate" value="{rate}"/>' if rate is not None and integrator == "volpath_snee" else ""
+    if integrator == "volpath_snee":
+        extra += f'<string name="connection" value="{connection}"/>'
     return f"""<scene version="3.0.0">
     <integrator type="{integrator}"><integer name="max_depth" value="-1"/>{extra}</integrator>
     <emitter type="directional"><vector name="direction" value="0, 0, -1"/><rgb name="irradiance" value="1, 1, 1"/></emitter>
@@ -63,29 +70,45 @@ def main():
     ap.add_argument("--seeds", type=int, default=8)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--rate", type=float, default=None, help="volpath_snee's snee_rate (default: its automatic rate)")
+    ap.add_argument("--connection", default="paper", choices=["paper", "complete"], help="volpath_snee's connection")
+    ap.add_argument("--integrators", default="volpath,volpath_snee", help="comma-separated")
+    ap.add_argument("--alphas", default="0.2,0.04,0.01,0.001,smooth", help="comma-separated; 'smooth': dielectric")
+    ap.add_argument("--no-surface", action="store_true", help="also report without the class `surface` (no medium vertex)")
     args = ap.parse_args()
-    alphas = [0.2, 0.04, 0.01, 0.001, None]
+    alphas = [None if a == "smooth" else float(a) for a in args.alphas.split(",")]
     rows = {}
     with tempfile.TemporaryDirectory() as tmp:
-        for integrator in ["volpath", "volpath_snee"]:
-            cells = []
+        for integrator in args.integrators.split(","):
+            cells, cells_ns = [], []
             for alpha in alphas:
                 xml = os.path.join(tmp, "slab.xml")
                 with open(xml, "w") as fh:
-                    fh.write(scene(integrator, alpha, args.spp, args.rate))
-                vals = []
+                    fh.write(scene(integrator, alpha, args.spp, args.rate, args.connection))
+                vals, vals_ns = [], []
                 for s in range(args.seeds):
                     out = os.path.join(tmp, "o.exr")
+                    extra = ["--classes"] if args.no_surface else []
                     subprocess.run([SNEE, "render", xml, "-o", out, "--seed", str(1 + s), "--threads",
-                                    str(args.threads)], check=True, capture_output=True)
-                    vals.append(read_exr_pixel(out))
+                                    str(args.threads)] + extra, check=True, capture_output=True)
+                    if args.no_surface:
+                        ch = common.read_exr(out)
+                        vals.append(float(ch["R"].reshape(-1)[0]))
+                        vals_ns.append(vals[-1] - float(ch["surface.R"].reshape(-1)[0]))
+                    else:
+                        vals.append(read_exr_pixel(out))
                 m = statistics.fmean(vals)
                 rel = statistics.stdev(vals) / m if m > 0 else float("nan")
                 cells.append((m, rel))
+                if vals_ns:
+                    m = statistics.fmean(vals_ns)
+                    cells_ns.append((m, statistics.stdev(vals_ns) / m if m > 0 else float("nan")))
             rows[integrator] = cells
+            if cells_ns:
+                rows[integrator + " without `surface`"] = cells_ns
     head = ["smooth" if a is None else f"{a}" for a in alphas]
     rate = "automatic" if args.rate is None else args.rate
-    print(f"slab n = 1.33, albedo 0.8, directional light; {args.seeds} seeds x {args.spp} spp; snee_rate {rate}")
+    print(f"slab n = 1.33, albedo 0.8, directional light; {args.seeds} seeds x {args.spp} spp; snee_rate {rate}; "
+          f"connection {args.connection}" )
     print("| alpha | " + " | ".join(head) + " |")
     print("|---|" + "---|" * len(head))
     for integrator, cells in rows.items():

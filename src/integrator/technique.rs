@@ -20,6 +20,8 @@
 //! of its own next to SNEE's (`manifold::ManifoldStage`, tables in `Snee::flat`): it connects from
 //! `x_j` rather than `x_i`, so its densities live in another measure and its MIS weights are its
 //! own (`manifold/pdf.rs`, `manifold/mis.rs`), with one call in `snee/sample.rs` for SNEE's side.
+//! Through a flat rough boundary (`manifold/rough.rs`) it shares suffixes with forward NEE at a rough
+//! `x_k` too: the loop asks the manifold stage first for that weight (`ManifoldStage::nee_weight`).
 
 use super::snee::{self, LightSample, Snee, SneeSuffix, SneeVertex};
 use super::stats::LocalStats;

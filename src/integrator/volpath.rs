@@ -182,6 +182,10 @@ impl ForwardWeight for ConnectionStages<'_, '_> {
     #[inline]
     fn emitter_sampling_weight(&self, cx: &mut Cx, ds: &DirectionSample, w: f32) -> f32 {
         let (scene, channel, stats) = (cx.scene, cx.channel, &mut *cx.stats);
+        // Forward NEE at a rough x_k right after x_j is shared with the manifold connection.
+        if let Some(w) = self.manifold.and_then(|m| m.nee_weight(scene, ds, channel, stats)) {
+            return w;
+        }
         self.snee.weight(scene, ForwardTechnique::Nee, || LightSample::sampled(ds), w, channel, stats)
     }
 }

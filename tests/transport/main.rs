@@ -9,6 +9,7 @@ mod common;
 mod manifold_finite;
 mod manifold_oblique;
 mod manifold_options;
+mod manifold_rough;
 mod manifold_slab;
 mod manifold_unbiased;
 mod snee_degenerate;

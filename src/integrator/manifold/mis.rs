@@ -43,7 +43,7 @@ pub fn env_light(scene: &Scene, si_k: &SurfaceInteraction, omega_l: Vec3) -> Opt
 }
 
 /// Forward density of `x_j` from `x_i` in volume measure (phase sampling, free flight in `channel`).
-fn p_volume(scene: &Scene, x_i: &SneeVertex, x_j: Vec3, channel: usize) -> f64 {
+pub(super) fn p_volume(scene: &Scene, x_i: &SneeVertex, x_j: Vec3, channel: usize) -> f64 {
     let m = &scene.media[x_i.medium as usize];
     let v = x_j - x_i.p;
     let t = v.length();

@@ -18,8 +18,8 @@
 //! forward technique can make (a delta light behind a delta interface) and shares V–V–S_t–L
 //! suffixes with SNEE; under an environment or an area light it also shares them with forward
 //! tracing ([`mis`]). Lights at a finite distance: [`finite`]. Scope (docs/manifold.md §6):
-//! boundaries made of flat facets ([`flat`]); elsewhere it draws no samples and `volpath_snee` is
-//! the paper's estimator.
+//! boundaries made of flat facets ([`flat`]; flat ROUGH facets under a directional light:
+//! [`rough`], §7); elsewhere it draws no samples and `volpath_snee` is the paper's estimator.
 //!
 //! The interface the volpath loop uses: a [`ManifoldStage`] per path next to SNEE's
 //! (`stage.rs`: [`sample`] at a medium vertex, the [`Tracker`] at surfaces, [`forward_weight`] for
@@ -32,6 +32,7 @@ pub mod flat;
 pub mod mis;
 pub mod pdf;
 pub mod planes;
+pub mod rough;
 pub mod stage;
 pub mod track;
 
@@ -107,7 +108,12 @@ const MAX_LIGHT_SEGMENTS: u32 = 64;
 /// Transmission of the light segment from `x_k` along `omega_l` to infinity through passable
 /// surfaces (`snee::passable`: the same definition as SNEE's, so both techniques have the same
 /// support); zero when anything else blocks it.
-fn light_segment(scene: &Scene, si_k: &SurfaceInteraction, omega_l: Vec3, stats: &mut LocalStats) -> Spectrum {
+pub(super) fn light_segment(
+    scene: &Scene,
+    si_k: &SurfaceInteraction,
+    omega_l: Vec3,
+    stats: &mut LocalStats,
+) -> Spectrum {
     let mut ray = Ray::new(offset_origin(si_k.p, si_k.n, omega_l), omega_l);
     let mut tr = Spectrum::ONE;
     for _ in 0..MAX_LIGHT_SEGMENTS {
@@ -169,6 +175,10 @@ pub fn connect(
 /// against forward tracing. `None` when the connection does not run here (then its density is 0
 /// for suffixes from `x_j`); it draws one 2-D sample whenever it runs.
 pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scatter) -> Option<Spectrum> {
+    // A flat rough boundary: its own connection (`rough.rs`).
+    if let Some(rb) = enabled(cx.scene).then(|| rough::boundary_of(cx.scene, v.medium)).flatten() {
+        return rough::sample(cx, opts, x_i, v, rb);
+    }
     let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
     let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
     let (beta, depth, max_depth) = (v.beta, v.depth, v.max_depth);
@@ -384,6 +394,9 @@ pub fn snee_weight(
 ) -> Option<f64> {
     if !enabled(scene) {
         return None;
+    }
+    if let Some(rb) = rough::boundary_of(scene, s.x_i.medium) {
+        return rough::snee_weight(scene, technique, rb, s, light, channel);
     }
     let boundary = boundary_of(scene, s.x_i.medium)?;
     let si_k = &s.si_k;

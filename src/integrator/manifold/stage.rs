@@ -7,19 +7,23 @@
 //! | real scatter `p` in a medium | [`ManifoldStage::at_scatter`] | `x_j = p`; one connection through the flat boundary, MIS-weighted against SNEE run at the previous vertex `x_i` (`manifold::sample`) |
 //! | the ray reaches a surface    | [`ManifoldStage::at_surface`] | takes the pending suffix `x_j → x_k → …` the ray carries ([`Tracker::surface_event`]) |
 //! | an emitter is hit            | [`ManifoldStage::weight`]     | the MIS weight of an escape right after leaving `x_j`'s medium (`manifold::forward_weight`) |
+//! | emitter sampling at `x_k`    | [`ManifoldStage::nee_weight`] | the MIS weight of forward NEE at a rough `x_k` right after `x_j` (`rough::nee_weight`) |
 //! | BSDF sampling at a surface   | [`ManifoldStage::after_bsdf`] | starts or carries the pending suffix ([`Tracker::after_bsdf`]) |
 //!
 //! SNEE's side of the MIS (a SNEE sample the connection could also have made) is one call in
 //! `snee/sample.rs` (`manifold::snee_weight`).
 
+use super::rough::RoughPending;
 use super::track::{Pending, Tracker};
 use super::{forward_weight, Connection};
-use crate::bsdf::BsdfSample;
+use crate::bsdf::{flags, BsdfSample};
 use crate::color::Spectrum;
 use crate::integrator::cx::Cx;
 use crate::integrator::cx::Scatter;
-use crate::integrator::snee::{Snee, SneeStage};
+use crate::integrator::snee::passable;
+use crate::integrator::snee::{Snee, SneeStage, SneeVertex};
 use crate::integrator::stats::LocalStats;
+use crate::interaction::DirectionSample;
 use crate::interaction::SurfaceInteraction;
 use crate::math::Vec3;
 use crate::scene::world::Scene;
@@ -34,6 +38,12 @@ pub struct ManifoldStage<'a> {
     arrived: Option<Pending>,
     /// The surface the current ray reached (`None`: it escaped, an environment hit).
     hit: Option<SurfaceInteraction>,
+    /// The SNEE vertex `x_i` just before the last medium vertex `x_j`, if any.
+    x_i: Option<SneeVertex>,
+    /// A path that left through a rough plane right after `x_j` (`rough.rs`): as the ray leaving the
+    /// last surface carries it, and as it was when the ray reached the current surface.
+    rough_pending: Option<RoughPending>,
+    rough_arrived: Option<RoughPending>,
 }
 
 impl<'a> ManifoldStage<'a> {
@@ -44,6 +54,9 @@ impl<'a> ManifoldStage<'a> {
             tracker: Tracker::default(),
             arrived: None,
             hit: None,
+            x_i: None,
+            rough_pending: None,
+            rough_arrived: None,
         })
     }
 
@@ -51,13 +64,30 @@ impl<'a> ManifoldStage<'a> {
     /// one connection. Returns its contribution.
     #[inline]
     pub fn at_scatter(&mut self, cx: &mut Cx, snee: &SneeStage, v: &Scatter) -> Spectrum {
+        self.x_i = snee.chain_x_i().copied();
         self.tracker.sample(cx, self.snee.options, snee.chain_x_i(), v)
+    }
+
+    /// The weight of forward NEE towards `ds` at the current surface, when it is a rough `x_k`
+    /// reached right after the medium vertex `x_j` (the manifold connection shares the path);
+    /// `None`: the caller's weight stands.
+    #[inline]
+    pub fn nee_weight(
+        &self,
+        scene: &Scene,
+        ds: &DirectionSample,
+        channel: usize,
+        stats: &mut LocalStats,
+    ) -> Option<f32> {
+        let (x_j, si_k) = (self.tracker.x_j.as_ref()?, self.hit.as_ref()?);
+        super::rough::nee_weight(scene, self.snee.options, self.x_i.as_ref(), x_j, si_k, ds, channel, stats)
     }
 
     /// The ray reached a surface (`None`: it escaped).
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.arrived = self.tracker.surface_event();
+        self.rough_arrived = self.rough_pending.take();
         self.hit = si.copied();
     }
 
@@ -72,6 +102,13 @@ impl<'a> ManifoldStage<'a> {
         channel: usize,
         stats: &mut LocalStats,
     ) -> Option<f32> {
+        if let Some(rp) = &self.rough_arrived {
+            // Through a rough plane: only an escape to the environment is shared.
+            return match self.hit {
+                None => super::rough::bsdf_hit_weight(scene, self.snee.options, rp, d, channel, stats),
+                Some(_) => None,
+            };
+        }
         let opts = Some(self.snee.options);
         forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.hit.as_ref(), d, channel, stats)
     }
@@ -79,6 +116,14 @@ impl<'a> ManifoldStage<'a> {
     /// BSDF sampling at `s` chose `bs` towards `wo`.
     #[inline]
     pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
+        let non_null = bs.sampled_type & flags::NULL == 0;
+        self.rough_pending = if non_null && bs.sampled_type & flags::TRANSMISSION != 0 && wo.dot(s.n) > 0.0 {
+            self.tracker.x_j.and_then(|x_j| super::rough::pending(scene, self.x_i, x_j, s))
+        } else if !non_null && passable(scene, s) {
+            self.rough_arrived.take()
+        } else {
+            None
+        };
         self.tracker.after_bsdf(scene, s, bs.sampled_type, wo, self.arrived.take());
     }
 }

@@ -58,6 +58,9 @@ pub struct Snee {
     /// Per medium: its flat smooth boundary where the manifold connection applies
     /// (`connection = complete`, `manifold::flat::flat_boundaries`; empty with `paper`).
     pub flat: Vec<Option<crate::integrator::manifold::planes::FlatBoundary>>,
+    /// Per medium: its flat rough boundary where the manifold connection applies
+    /// (`connection = complete`, `manifold::rough::rough_boundaries`; empty with `paper`).
+    pub rough: Vec<Option<crate::integrator::manifold::rough::RoughBoundary>>,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).

@@ -1,0 +1,557 @@
+//! Manifold NEE through a flat ROUGH boundary (`roughdielectric`, GGX or Beckmann, isotropic, any
+//! `alpha`): from a medium vertex `x_j`, connect to a DIRECTIONAL light or the ENVIRONMENT through a
+//! microfacet refraction at the boundary (docs/manifold.md §7).
+//!
+//! On a flat facet the interface looks the same everywhere, so the inner direction can be sampled
+//! from the light side without knowing where `x_k` is: `omega_in ~ bsdf.sample` with `wi = omega_l`
+//! in importance mode (a visible microfacet normal seen from the light, refracted; a sampled
+//! reflection fails), then `x_k` is the first hit from `x_j` along `omega_jk = −omega_in`, which
+//! must lie on that plane of the enclosing boundary. Conditioned on `x_j`, the density of
+//! `omega_jk` (solid angle at `x_j`) is
+//!
+//! ```text
+//! p_man = p_light · p_imp(omega_in | omega_l)        (p_imp = bsdf.pdf in importance mode)
+//! ```
+//!
+//! (`p_light`: `p_sel` for a directional light, `p_env(omega_l)` for the environment, whose
+//! densities are then also per solid angle of `omega_l`)
+//!
+//! and the estimate `f_p(wi_j, ω_jk) T(d_jk) f_s(x_k; ω_kj → ω_l) tr_light · E / p_man`, with
+//! `f_s` Mitsuba's radiance-mode `eval` (cosine of `ω_l` included). Every plane orientation of the
+//! boundary gets its own sample (the sets of paths through different orientations are disjoint).
+//! The competitors for the same suffix `x_j → x_k → light`, in the same measure ([`rough_pdfs`]):
+//! forward NEE at `x_k` (`f_p e^{−σ_t d_jk} p_light`), forward BSDF sampling (`f_p e^{−σ_t d_jk}
+//! bsdf.pdf(ω_kj → ω_l)`, 0 for a delta light, [`bsdf_hit_weight`]) and SNEE from the vertex `x_i` before `x_j` (its `dV(x_j) dA(x_k)` density over
+//! forward's density of `x_j` and `dA(x_k)/dω_jk`). The power heuristic over the four,
+//! [`rough_weight`], is computed by the same function at the three places that make such a
+//! suffix: this connection ([`sample`]), forward NEE at `x_k` ([`nee_weight`], through the
+//! manifold stage) and SNEE ([`snee_weight`], through `manifold::snee_weight`).
+//!
+//! Scope: directional lights and the environment (area and point lights through a rough boundary
+//! keep the paper's estimator: the connection contributes nothing for them, so its density is 0
+//! and their weights are unchanged); isotropic roughness (the plane's frame then does not matter).
+
+use super::planes::{MAX_PLANES, SAME_NORMAL};
+use super::{light_segment, MediumVertex};
+use crate::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
+use crate::color::Spectrum;
+use crate::integrator::cx::{Cx, Scatter};
+use crate::integrator::snee::SneeVertex;
+use crate::integrator::snee::{self, with_wi, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeTransport};
+use crate::integrator::stats::LocalStats;
+use crate::interaction::{offset_origin, spawn_ray_between, DirectionSample, SurfaceInteraction};
+use crate::math::{Frame, Ray, Vec2, Vec3};
+use crate::scene::world::Scene;
+use crate::shape::Geometry;
+
+/// One orientation of a rough boundary: outward unit normal and the `roughdielectric` (index into
+/// `Scene::bsdfs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoughPlane {
+    pub n: Vec3,
+    pub bsdf: u32,
+}
+
+/// The flat rough boundary of one medium: its distinct (normal, BSDF) orientations.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RoughBoundary {
+    pub planes: Vec<RoughPlane>,
+}
+
+impl RoughBoundary {
+    /// The orientation with geometric normal `n` and BSDF `bsdf`.
+    pub fn plane_at(&self, n: Vec3, bsdf: u32) -> Option<&RoughPlane> {
+        self.planes.iter().find(|p| p.bsdf == bsdf && p.n.dot(n) > SAME_NORMAL)
+    }
+}
+
+/// Per medium of `scene`: its flat rough boundary, or `None` (no emitter, the medium does not sample
+/// emitters, or some enclosing shape is not a flat-shaded mesh with an isotropic `roughdielectric`,
+/// or there are more than [`MAX_PLANES`] orientations).
+pub fn rough_boundaries(scene: &Scene) -> Vec<Option<RoughBoundary>> {
+    let lit = !scene.emitters.is_empty();
+    (0..scene.media.len() as u32).map(|m| if lit { rough_boundary(scene, m) } else { None }).collect()
+}
+
+fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
+    if !scene.media[medium as usize].sample_emitters {
+        return None;
+    }
+    let mut planes: Vec<RoughPlane> = Vec::new();
+    let mut enclosed = false;
+    for s in scene.shapes.iter().filter(|s| s.interior == Some(medium) && s.exterior.is_none()) {
+        match &scene.bsdfs[s.bsdf as usize] {
+            Bsdf::RoughDielectric(r) if r.alpha_u == r.alpha_v => {}
+            Bsdf::RoughDielectric(_) | Bsdf::Dielectric(_) => return None,
+            _ => continue,
+        }
+        let Geometry::Mesh(mesh) = &s.geometry else { return None };
+        enclosed = true;
+        for (prim, idx) in mesh.indices.iter().enumerate() {
+            let [p0, p1, p2] = mesh.vertices(prim as u32);
+            let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+            if n == Vec3::ZERO {
+                continue;
+            }
+            if mesh.flip_normals {
+                n = -n;
+            }
+            if !mesh.normals.is_empty() {
+                let flat = idx.iter().all(|&i| {
+                    let vn = mesh.normals[i as usize];
+                    let vn = if mesh.flip_normals { -vn } else { vn };
+                    vn.dot(n) > SAME_NORMAL
+                });
+                if !flat {
+                    return None;
+                }
+            }
+            if !planes.iter().any(|q| q.bsdf == s.bsdf && q.n.dot(n) > SAME_NORMAL) {
+                planes.push(RoughPlane { n, bsdf: s.bsdf });
+                if planes.len() > MAX_PLANES {
+                    return None;
+                }
+            }
+        }
+    }
+    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes })
+}
+
+/// The rough boundary of `medium` (built with `connection = complete`).
+#[inline]
+pub fn boundary_of(scene: &Scene, medium: u32) -> Option<&RoughBoundary> {
+    super::tables(scene)?.rough.get(medium as usize)?.as_ref()
+}
+
+/// A surface interaction in the plane's frame (normal `n`) whose incident direction is `wi`.
+fn plane_si(n: Vec3, wi: Vec3) -> SurfaceInteraction {
+    let sh_frame = Frame::from_normal(n);
+    SurfaceInteraction {
+        t: 0.0,
+        p: Vec3::ZERO,
+        n,
+        sh_frame,
+        uv: Vec2::ZERO,
+        wi: sh_frame.to_local(wi),
+        shape: 0,
+        prim: 0,
+    }
+}
+
+/// Sample the direction `omega_jk` (from `x_j` towards the boundary, `= −omega_in`) through a plane
+/// of normal `n` with the rough dielectric `bsdf` lit from `omega_l`: `omega_in ~ bsdf.sample` with
+/// `wi = omega_l` in importance mode; `None` when the light is behind the plane or a reflection
+/// was sampled. Density: [`pdf_inner`].
+pub fn sample_inner(bsdf: &Bsdf, n: Vec3, omega_l: Vec3, u1: f32, u2: Vec2) -> Option<Vec3> {
+    if !(n.dot(omega_l) > 0.0) {
+        return None;
+    }
+    let si = plane_si(n, omega_l);
+    let (bs, _) = bsdf.sample(&BsdfContext::new(TransportMode::Importance), &si, u1, u2)?;
+    if bs.sampled_type & flags::TRANSMISSION == 0 || !(bs.pdf > 0.0) {
+        return None;
+    }
+    let omega_in = si.to_world(bs.wo).normalize();
+    (omega_in.dot(n) < 0.0).then_some(-omega_in)
+}
+
+/// Solid-angle density of [`sample_inner`]'s `omega_jk` (the `1 − F` of choosing the
+/// transmission included: the directions integrate to the transmitted fraction).
+pub fn pdf_inner(bsdf: &Bsdf, n: Vec3, omega_l: Vec3, omega_jk: Vec3) -> f64 {
+    if !(n.dot(omega_l) > 0.0) || !(omega_jk.dot(n) > 0.0) {
+        return 0.0;
+    }
+    let si = plane_si(n, omega_l);
+    let p = bsdf.pdf(&BsdfContext::new(TransportMode::Importance), &si, si.to_local(-omega_jk)) as f64;
+    if p.is_finite() && p > 0.0 {
+        p
+    } else {
+        0.0
+    }
+}
+
+/// Is `si` (hit from inside `medium` along `d`) on the orientation `plane` of its rough boundary?
+fn on_plane(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3, plane: &RoughPlane) -> bool {
+    let s = &scene.shapes[si.shape as usize];
+    s.interior == Some(medium)
+        && s.exterior.is_none()
+        && d.dot(si.n) > 0.0
+        && s.bsdf == plane.bsdf
+        && si.n.dot(plane.n) > SAME_NORMAL
+}
+
+/// The four techniques' densities of one suffix `x_j → x_k → light` through a rough plane (solid
+/// angle of `omega_jk` at `x_j`, conditioned on `x_j`; for a non-delta light also per solid angle
+/// of `omega_l`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RoughPdfs {
+    pub manifold: f64,
+    pub fwd_nee: f64,
+    pub fwd_bsdf: f64,
+    /// 0 outside SNEE's support.
+    pub snee: f64,
+}
+
+/// The densities of the suffix `x_j → x_k → light` (plus `x_i` before, when it is the SNEE vertex
+/// just before `x_j`), with `omega_jk` the direction the path took from `x_j` and `d_jk` its
+/// length. The direction is passed rather than recomputed from the points: at small roughness the
+/// lobe is narrower than the error of `(x_k − x_j)/d` for a vertex `x_j` close to the surface.
+/// `check_support`: test that `x_k` is visible from `x_i` (SNEE's probe); the caller passes
+/// `false` when it knows. The light segment is the caller's business.
+#[allow(clippy::too_many_arguments)]
+pub fn rough_pdfs(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    (si_k, omega_jk, d_jk): (&SurfaceInteraction, Vec3, f32),
+    plane: &RoughPlane,
+    light: &LightSample,
+    channel: usize,
+    check_support: bool,
+    stats: &mut LocalStats,
+) -> RoughPdfs {
+    let m = &scene.media[x_j.medium as usize];
+    let bsdf = &scene.bsdfs[plane.bsdf as usize];
+    let st = m.sigma_t[channel] as f64;
+    // Forward: phase sampling at x_j, a free flight that survives to x_k.
+    let fwd = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp();
+    let fwd_nee = fwd * light.p_light as f64;
+    let fwd_bsdf = if light.delta {
+        0.0
+    } else {
+        let si_kj = with_wi(si_k, -omega_jk);
+        fwd * bsdf.pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l)) as f64
+    };
+    let manifold = if !light.dist.is_finite() {
+        light.p_light as f64 * pdf_inner(bsdf, plane.n, light.omega_l, omega_jk)
+    } else {
+        0.0
+    };
+    let mut snee = 0.0;
+    if let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) {
+        let visible = !check_support || {
+            stats.rays += 1;
+            let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
+            !scene.ray_test(&spawn_ray_between(x_i.p, inner_k))
+        };
+        if let (true, Some(tables)) = (visible, super::tables(scene)) {
+            let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
+            let pdf_snee = snee::pdf_snee(scene, tables, &suffix, light, channel);
+            let cos_k = omega_jk.dot(si_k.n).abs() as f64;
+            let to_sa = super::mis::p_volume(scene, x_i, x_j.p, channel) * cos_k / (d_jk as f64 * d_jk as f64);
+            if to_sa > 0.0 {
+                snee = pdf_snee / to_sa;
+            }
+        }
+    }
+    let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
+    RoughPdfs { manifold: finite(manifold), fwd_nee: finite(fwd_nee), fwd_bsdf: finite(fwd_bsdf), snee: finite(snee) }
+}
+
+/// Which technique made a suffix through a rough plane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RoughTechnique {
+    Manifold,
+    FwdNee,
+    FwdBsdf,
+    Snee,
+}
+
+/// Weight of `technique` for a suffix with densities `p`: the power heuristic over the four
+/// (`snee = mis`); `snee = snee`: SNEE takes what it can make, the others share the rest;
+/// `snee = forward`: SNEE's density is 0. `transport = snee`: suffixes outside SNEE's support get 0.
+pub fn rough_weight(opts: SneeOptions, technique: RoughTechnique, p: RoughPdfs) -> f64 {
+    let s = if opts.technique == SneeTechnique::Forward { 0.0 } else { p.snee };
+    if opts.transport == SneeTransport::Snee && s == 0.0 {
+        return 0.0;
+    }
+    if opts.technique == SneeTechnique::Snee && s > 0.0 {
+        return if technique == RoughTechnique::Snee { 1.0 } else { 0.0 };
+    }
+    let own = match technique {
+        RoughTechnique::Manifold => p.manifold,
+        RoughTechnique::FwdNee => p.fwd_nee,
+        RoughTechnique::FwdBsdf => p.fwd_bsdf,
+        RoughTechnique::Snee => s,
+    };
+    if !(own > 0.0) {
+        return 0.0;
+    }
+    // Ratios against the own density avoid overflow of the squares.
+    let (a, b, c, d) = (p.manifold / own, p.fwd_nee / own, p.fwd_bsdf / own, s / own);
+    let w = 1.0 / (a * a + b * b + c * c + d * d);
+    if w.is_finite() {
+        w
+    } else {
+        0.0
+    }
+}
+
+/// One verified connection through a rough plane.
+struct RoughConnection {
+    si_k: SurfaceInteraction,
+    omega_jk: Vec3,
+    /// `f_p · T · f_s · tr_light` (without the light's `E / p_sel` and the density).
+    f: Spectrum,
+}
+
+/// Sample `omega_jk` through `plane` ([`sample_inner`]), find `x_k` (the first hit from `x_j` must
+/// lie on that plane of the boundary, seen from inside) and the light segment. Counts solutions
+/// and failures (a sampled reflection is neither).
+fn connect(
+    scene: &Scene,
+    x_j: &MediumVertex,
+    plane: &RoughPlane,
+    omega_l: Vec3,
+    u1: f32,
+    u2: Vec2,
+    stats: &mut LocalStats,
+) -> Option<RoughConnection> {
+    let bsdf = &scene.bsdfs[plane.bsdf as usize];
+    let omega_jk = sample_inner(bsdf, plane.n, omega_l, u1, u2)?;
+    stats.rays += 1;
+    let si_k = match scene.ray_intersect(&Ray::new(x_j.p, omega_jk)) {
+        Some(si) if on_plane(scene, &si, x_j.medium, omega_jk, plane) => si,
+        _ => {
+            stats.manifold_failures += 1;
+            return None;
+        }
+    };
+    let tr = light_segment(scene, &si_k, omega_l, stats);
+    if tr == Spectrum::ZERO {
+        stats.manifold_failures += 1;
+        return None;
+    }
+    stats.manifold_solutions += 1;
+    let si_kj = with_wi(&si_k, -omega_jk);
+    let f_s = bsdf.eval(&BsdfContext::default(), &si_kj, si_k.to_local(omega_l));
+    let m = &scene.media[x_j.medium as usize];
+    let f = m.phase.eval(x_j.wi, omega_jk) * m.transmittance(si_k.t) * f_s * tr;
+    Some(RoughConnection { si_k, omega_jk, f })
+}
+
+/// The manifold stage at a real scatter `v` inside the rough boundary `rb`: one emitter sample and,
+/// per orientation, one sampled refraction (a 1-D and a 2-D sample each, drawn whatever the light),
+/// each MIS-weighted ([`rough_weight`]). Only a directional light is connected; `None` when the
+/// depth budget leaves no room for `x_k` (then the connection does not run at `x_j`).
+pub fn sample(
+    cx: &mut Cx,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    v: &Scatter,
+    rb: &RoughBoundary,
+) -> Option<Spectrum> {
+    let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
+    let u: Vec2 = sampler.next_2d();
+    if v.depth.saturating_add(1) >= v.max_depth {
+        return None;
+    }
+    stats.manifold_attempts += 1;
+    let (ds, weight) = scene.sample_emitter_direction(v.p, None, u, false);
+    // A directional light or the environment (infinitely far: omega_l is the same at every x_k).
+    let distant = ds.pdf > 0.0
+        && !ds.dist.is_finite()
+        && weight != Spectrum::ZERO
+        && (ds.delta || scene.environment == Some(ds.emitter));
+    let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
+    let light =
+        LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: ds.delta, le: Spectrum::ZERO };
+    let mut result = Spectrum::ZERO;
+    for plane in &rb.planes {
+        let (u1, u2) = (sampler.next_1d(), sampler.next_2d());
+        if !distant {
+            continue;
+        }
+        let Some(c) = connect(scene, &x_j, plane, ds.d, u1, u2, stats) else { continue };
+        let path = (&c.si_k, c.omega_jk, c.si_k.t);
+        let p = rough_pdfs(scene, opts, x_i, &x_j, path, plane, &light, channel, true, stats);
+        let w = rough_weight(opts, RoughTechnique::Manifold, p);
+        if !(w > 0.0) {
+            continue;
+        }
+        // E / p_sel or L / p_env (weight) · w / p_imp, with p_man = p_light · p_imp.
+        let contribution = v.beta * c.f * weight * (w * ds.pdf as f64 / p.manifold) as f32;
+        if crate::color::is_finite(contribution) {
+            result += contribution;
+        } else {
+            stats.rejected_samples += 1;
+        }
+    }
+    Some(result)
+}
+
+/// The weight of forward NEE at a rough `x_k` reached right after the medium vertex `x_j` (where the
+/// connection ran; `x_i`: the SNEE vertex just before `x_j`, if any) towards the emitter sample
+/// `ds`; `None` where the connection cannot make the path (the caller's weight stands).
+#[allow(clippy::too_many_arguments)]
+pub fn nee_weight(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    si_k: &SurfaceInteraction,
+    ds: &DirectionSample,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<f32> {
+    if ds.dist.is_finite() || !(ds.delta || scene.environment == Some(ds.emitter)) {
+        return None;
+    }
+    let rb = boundary_of(scene, x_j.medium)?;
+    // The direction the forward path took (the ray's, not recomputed from the points).
+    let omega_jk = -si_k.to_world(si_k.wi).normalize();
+    let d_jk = (si_k.p - x_j.p).length();
+    let plane = rb.plane_at(si_k.n, scene.shapes[si_k.shape as usize].bsdf)?;
+    if !on_plane(scene, si_k, x_j.medium, omega_jk, plane) || light_segment(scene, si_k, ds.d, stats) == Spectrum::ZERO
+    {
+        return None;
+    }
+    let light = LightSample::sampled(ds);
+    let p = rough_pdfs(scene, opts, x_i, x_j, (si_k, omega_jk, d_jk), plane, &light, channel, true, stats);
+    Some(rough_weight(opts, RoughTechnique::FwdNee, p) as f32)
+}
+
+/// SNEE's weight for a suffix it made through a rough plane towards a directional light, or `None`
+/// (another light: SNEE's own weight stands).
+pub fn snee_weight(
+    scene: &Scene,
+    technique: SneeTechnique,
+    rb: &RoughBoundary,
+    s: &SneeSuffix,
+    light: &LightSample,
+    channel: usize,
+) -> Option<f64> {
+    if light.dist.is_finite() || !(light.delta || scene.environment.is_some()) {
+        return None;
+    }
+    let si_k = &s.si_k;
+    let plane = rb.plane_at(si_k.n, scene.shapes[si_k.shape as usize].bsdf)?;
+    let v_ij = s.x_j - s.x_i.p;
+    let t_ij = v_ij.length();
+    if !(t_ij > 0.0) {
+        return None;
+    }
+    let x_j = MediumVertex { p: s.x_j, wi: -v_ij / t_ij, medium: s.x_i.medium };
+    let v_jk = si_k.p - s.x_j;
+    let d_jk = v_jk.length();
+    let path = (si_k, v_jk / d_jk, d_jk);
+    let opts = SneeOptions { technique, ..scene.integrator.snee };
+    // SNEE made it: x_k is visible from x_i and the light segment is clear; no rays traced.
+    let mut no_rays = LocalStats::default();
+    let p = rough_pdfs(scene, opts, Some(&s.x_i), &x_j, path, plane, light, channel, false, &mut no_rays);
+    Some(rough_weight(opts, RoughTechnique::Snee, p))
+}
+
+/// A forward path that refracted out through a rough plane at `x_k` right after the medium vertex
+/// `x_j` (`x_i`: the SNEE vertex before `x_j`, if any), until it escapes to the environment
+/// (carried across passable surfaces only, as the connection's light segment).
+#[derive(Clone, Copy, Debug)]
+pub struct RoughPending {
+    pub x_i: Option<SneeVertex>,
+    pub x_j: MediumVertex,
+    /// `x_k`, its `wi` pointing back to `x_j` along the path.
+    pub si_k: SurfaceInteraction,
+    pub plane: RoughPlane,
+}
+
+/// The pending suffix when BSDF sampling at `s` (reached right after `x_j`) refracted out through a
+/// rough plane of `x_j`'s boundary; `None` otherwise.
+pub fn pending(
+    scene: &Scene,
+    x_i: Option<SneeVertex>,
+    x_j: MediumVertex,
+    s: &SurfaceInteraction,
+) -> Option<RoughPending> {
+    let rb = boundary_of(scene, x_j.medium)?;
+    let plane = *rb.plane_at(s.n, scene.shapes[s.shape as usize].bsdf)?;
+    let omega_jk = -s.to_world(s.wi);
+    on_plane(scene, s, x_j.medium, omega_jk, &plane).then_some(RoughPending { x_i, x_j, si_k: *s, plane })
+}
+
+/// The weight of forward BSDF sampling for a path that left through a rough plane right after `x_j`
+/// and escaped along `omega_l` to the environment; `None` without an environment.
+pub fn bsdf_hit_weight(
+    scene: &Scene,
+    opts: SneeOptions,
+    rp: &RoughPending,
+    omega_l: Vec3,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<f32> {
+    let light = super::mis::env_light(scene, &rp.si_k, omega_l)?;
+    let omega_jk = -rp.si_k.to_world(rp.si_k.wi).normalize();
+    let d_jk = (rp.si_k.p - rp.x_j.p).length();
+    let path = (&rp.si_k, omega_jk, d_jk);
+    let p = rough_pdfs(scene, opts, rp.x_i.as_ref(), &rp.x_j, path, &rp.plane, &light, channel, true, stats);
+    Some(rough_weight(opts, RoughTechnique::FwdBsdf, p) as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::microfacet::MicrofacetType;
+    use crate::bsdf::rough_dielectric::RoughDielectric;
+    use crate::testing::chi2::{chi2_sphere, sidak};
+
+    fn rough(kind: MicrofacetType, alpha: f32, eta: f32) -> Bsdf {
+        Bsdf::RoughDielectric(RoughDielectric {
+            eta,
+            inv_eta: 1.0 / eta,
+            distribution: kind,
+            alpha_u: alpha,
+            alpha_v: alpha,
+            sample_visible: true,
+            specular_reflectance: None,
+            specular_transmittance: None,
+        })
+    }
+
+    /// The directions `omega_jk` of [`sample_inner`] follow [`pdf_inner`] (chi-square over the
+    /// sphere; the sampled reflections are the missing mass), GGX and Beckmann, three roughnesses,
+    /// two indices, oblique light on a tilted plane. Sample counts chosen before the first run.
+    #[test]
+    fn inner_direction_sampling_matches_pdf() {
+        let n = Vec3::new(0.2, -0.3, 0.9).normalize();
+        let cases: Vec<(MicrofacetType, f32, f32)> = [MicrofacetType::Ggx, MicrofacetType::Beckmann]
+            .into_iter()
+            .flat_map(|k| [(k, 0.5, 1.33), (k, 0.2, 1.5), (k, 0.08, 1.33), (k, 0.2, 1.0 / 1.33)])
+            .collect();
+        let level = sidak(0.01, cases.len());
+        for (kind, alpha, eta) in cases {
+            let bsdf = rough(kind, alpha, eta);
+            let omega_l = (n + Vec3::new(0.5, 0.4, -0.1)).normalize();
+            let r = chi2_sphere(
+                |u1, u2| sample_inner(&bsdf, n, omega_l, u1, u2),
+                |d| pdf_inner(&bsdf, n, omega_l, d) as f32,
+                32,
+                64,
+                400_000,
+                level,
+                7,
+            );
+            assert!(r.passed, "{kind:?} alpha {alpha} eta {eta}\n{}", r.report);
+        }
+    }
+
+    #[test]
+    fn rough_weights_partition_unity() {
+        let all = [RoughTechnique::Manifold, RoughTechnique::FwdNee, RoughTechnique::FwdBsdf, RoughTechnique::Snee];
+        for technique in [SneeTechnique::Mis, SneeTechnique::Snee, SneeTechnique::Forward] {
+            let opts = SneeOptions { technique, ..SneeOptions::default() };
+            for p in [
+                RoughPdfs { manifold: 1.0, fwd_nee: 2.0, fwd_bsdf: 3.0, snee: 4.0 },
+                RoughPdfs { manifold: 1e-20, fwd_nee: 5.0, fwd_bsdf: 0.0, snee: 0.0 },
+                RoughPdfs { manifold: 1e12, fwd_nee: 1e-3, fwd_bsdf: 0.0, snee: 1e10 },
+                RoughPdfs { manifold: 0.0, fwd_nee: 1.0, fwd_bsdf: 1.0, snee: 1.0 },
+            ] {
+                let sum: f64 = all
+                    .iter()
+                    .filter(|t| **t != RoughTechnique::Snee || technique != SneeTechnique::Forward)
+                    .map(|t| rough_weight(opts, *t, p))
+                    .sum();
+                assert!((sum - 1.0).abs() < 1e-12, "{technique:?} {p:?}: {sum}");
+            }
+        }
+    }
+}
