@@ -87,6 +87,7 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
     let mut snee = snee::rate::build(scene, options);
     if connection == Connection::Complete {
         snee.flat = manifold::flat::flat_boundaries(scene);
+        snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
     }
     snee
 }

@@ -27,9 +27,11 @@
 //! `snee/sample.rs`). The flat boundaries are built at scene load into `volpath_snee`'s tables
 //! ([`Snee::flat`], read through [`tables`]).
 
+pub mod curved;
 pub mod finite;
 pub mod flat;
 pub mod mis;
+pub mod newton;
 pub mod pdf;
 pub mod planes;
 pub mod stage;
@@ -107,7 +109,12 @@ const MAX_LIGHT_SEGMENTS: u32 = 64;
 /// Transmission of the light segment from `x_k` along `omega_l` to infinity through passable
 /// surfaces (`snee::passable`: the same definition as SNEE's, so both techniques have the same
 /// support); zero when anything else blocks it.
-fn light_segment(scene: &Scene, si_k: &SurfaceInteraction, omega_l: Vec3, stats: &mut LocalStats) -> Spectrum {
+pub(super) fn light_segment(
+    scene: &Scene,
+    si_k: &SurfaceInteraction,
+    omega_l: Vec3,
+    stats: &mut LocalStats,
+) -> Spectrum {
     let mut ray = Ray::new(offset_origin(si_k.p, si_k.n, omega_l), omega_l);
     let mut tr = Spectrum::ONE;
     for _ in 0..MAX_LIGHT_SEGMENTS {
@@ -175,7 +182,7 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     if !enabled(scene) {
         return None;
     }
-    let boundary = boundary_of(scene, x_j.medium)?;
+    let Some(boundary) = boundary_of(scene, x_j.medium) else { return curved::sample(cx, opts, x_i, v) };
     let u: Vec2 = sampler.next_2d();
     // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).
     if depth.saturating_add(1) >= max_depth {

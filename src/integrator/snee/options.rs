@@ -58,6 +58,8 @@ pub struct Snee {
     /// Per medium: its flat smooth boundary where the manifold connection applies
     /// (`connection = complete`, `manifold::flat::flat_boundaries`; empty with `paper`).
     pub flat: Vec<Option<crate::integrator::manifold::planes::FlatBoundary>>,
+    /// Per medium: does the curved connection apply (`manifold::curved::curved_boundaries`)?
+    pub curved: Vec<bool>,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).
