@@ -189,6 +189,7 @@ pub fn connect(
 
 /// Is the suffix `x_i → x_j → x_k → light` in SNEE's support (SNEE's density positive)? The
 /// partition of this file's MIS: such suffixes are SNEE's alone.
+#[allow(clippy::too_many_arguments)]
 fn in_snee_support(
     scene: &Scene,
     opts: SneeOptions,
