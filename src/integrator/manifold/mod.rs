@@ -18,8 +18,9 @@
 //! forward technique can make (a delta light behind a delta interface) and shares V–V–S_t–L
 //! suffixes with SNEE; under an environment or an area light it also shares them with forward
 //! tracing ([`mis`]). Lights at a finite distance: [`finite`]. Scope (docs/manifold.md §6):
-//! boundaries made of flat facets ([`flat`]); elsewhere it draws no samples and `volpath_snee` is
-//! the paper's estimator.
+//! boundaries made of flat facets ([`flat`]); curved smooth boundaries under a directional light
+//! ([`curved`], Newton and specular manifold sampling in [`newton`], docs/manifold.md §7);
+//! elsewhere it draws no samples and `volpath_snee` is the paper's estimator.
 //!
 //! The interface the volpath loop uses: a [`ManifoldStage`] per path next to SNEE's
 //! (`stage.rs`: [`sample`] at a medium vertex, the [`Tracker`] at surfaces, [`forward_weight`] for
