@@ -68,6 +68,11 @@ pub struct RenderStats {
     pub manifold_attempts: u64,
     pub manifold_solutions: u64,
     pub manifold_failures: u64,
+    pub manifold_newton_solves: u64,
+    pub manifold_newton_iterations: u64,
+    pub manifold_newton_failures: u64,
+    pub manifold_newton_lost: u64,
+    pub manifold_trials_capped: u64,
 }
 
 impl RenderStats {
@@ -86,6 +91,11 @@ impl RenderStats {
             "manifold_attempts": self.manifold_attempts,
             "manifold_solutions": self.manifold_solutions,
             "manifold_failures": self.manifold_failures,
+            "manifold_newton_solves": self.manifold_newton_solves,
+            "manifold_newton_iterations": self.manifold_newton_iterations,
+            "manifold_newton_failures": self.manifold_newton_failures,
+            "manifold_newton_lost": self.manifold_newton_lost,
+            "manifold_trials_capped": self.manifold_trials_capped,
         })
     }
 }
@@ -429,6 +439,11 @@ pub fn render_range(
             manifold_attempts: stats.manifold_attempts.load(Ordering::Relaxed),
             manifold_solutions: stats.manifold_solutions.load(Ordering::Relaxed),
             manifold_failures: stats.manifold_failures.load(Ordering::Relaxed),
+            manifold_newton_solves: stats.manifold_newton_solves.load(Ordering::Relaxed),
+            manifold_newton_iterations: stats.manifold_newton_iterations.load(Ordering::Relaxed),
+            manifold_newton_failures: stats.manifold_newton_failures.load(Ordering::Relaxed),
+            manifold_newton_lost: stats.manifold_newton_lost.load(Ordering::Relaxed),
+            manifold_trials_capped: stats.manifold_trials_capped.load(Ordering::Relaxed),
         },
     }
 }

@@ -12,6 +12,11 @@ pub struct Stats {
     pub manifold_attempts: AtomicU64,
     pub manifold_solutions: AtomicU64,
     pub manifold_failures: AtomicU64,
+    pub manifold_newton_solves: AtomicU64,
+    pub manifold_newton_iterations: AtomicU64,
+    pub manifold_newton_failures: AtomicU64,
+    pub manifold_newton_lost: AtomicU64,
+    pub manifold_trials_capped: AtomicU64,
 }
 
 /// Thread-local counters, flushed into [`Stats`] once per tile.
@@ -30,6 +35,17 @@ pub struct LocalStats {
     /// Candidate planes facing the light whose solution failed verification (another surface
     /// first, or the light segment blocked).
     pub manifold_failures: u64,
+    /// Newton solves on curved boundaries (`manifold/curved.rs`), one per seed.
+    pub manifold_newton_solves: u64,
+    /// Newton iterations summed over the solves.
+    pub manifold_newton_iterations: u64,
+    /// Solves that did not converge (iteration limit, no descent, singular Jacobian).
+    pub manifold_newton_failures: u64,
+    /// Solves whose walk left the enclosing boundary (another surface first, total internal
+    /// reflection, or the boundary met from outside).
+    pub manifold_newton_lost: u64,
+    /// Specular manifold sampling's Bernoulli trials stopped at the cap (`newton::MAX_TRIALS`).
+    pub manifold_trials_capped: u64,
 }
 
 impl Stats {
@@ -41,5 +57,10 @@ impl Stats {
         self.manifold_attempts.fetch_add(l.manifold_attempts, Ordering::Relaxed);
         self.manifold_solutions.fetch_add(l.manifold_solutions, Ordering::Relaxed);
         self.manifold_failures.fetch_add(l.manifold_failures, Ordering::Relaxed);
+        self.manifold_newton_solves.fetch_add(l.manifold_newton_solves, Ordering::Relaxed);
+        self.manifold_newton_iterations.fetch_add(l.manifold_newton_iterations, Ordering::Relaxed);
+        self.manifold_newton_failures.fetch_add(l.manifold_newton_failures, Ordering::Relaxed);
+        self.manifold_newton_lost.fetch_add(l.manifold_newton_lost, Ordering::Relaxed);
+        self.manifold_trials_capped.fetch_add(l.manifold_trials_capped, Ordering::Relaxed);
     }
 }

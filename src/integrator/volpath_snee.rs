@@ -88,6 +88,7 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
     if connection == Connection::Complete {
         snee.flat = manifold::flat::flat_boundaries(scene);
         snee.rough = manifold::rough::rough_boundaries(scene);
+        snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
     }
     snee
 }

@@ -18,8 +18,10 @@
 //! forward technique can make (a delta light behind a delta interface) and shares V–V–S_t–L
 //! suffixes with SNEE; under an environment or an area light it also shares them with forward
 //! tracing ([`mis`]). Lights at a finite distance: [`finite`]. Scope (docs/manifold.md §6):
-//! boundaries made of flat facets ([`flat`]; flat ROUGH facets under a directional light:
-//! [`rough`], §7); elsewhere it draws no samples and `volpath_snee` is the paper's estimator.
+//! boundaries made of flat facets ([`flat`]; flat ROUGH facets under a directional light or an
+//! environment: [`rough`], §7); curved smooth boundaries under a directional light ([`curved`],
+//! Newton and specular manifold sampling in [`newton`], §8); elsewhere it draws no samples and
+//! `volpath_snee` is the paper's estimator.
 //!
 //! The interface the volpath loop uses: a [`ManifoldStage`] per path next to SNEE's
 //! (`stage.rs`: [`sample`] at a medium vertex, the [`Tracker`] at surfaces, [`forward_weight`] for
@@ -27,9 +29,11 @@
 //! `snee/sample.rs`). The flat boundaries are built at scene load into `volpath_snee`'s tables
 //! ([`Snee::flat`], read through [`tables`]).
 
+pub mod curved;
 pub mod finite;
 pub mod flat;
 pub mod mis;
+pub mod newton;
 pub mod pdf;
 pub mod planes;
 pub mod rough;
@@ -185,7 +189,7 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     if !enabled(scene) {
         return None;
     }
-    let boundary = boundary_of(scene, x_j.medium)?;
+    let Some(boundary) = boundary_of(scene, x_j.medium) else { return curved::sample(cx, opts, x_i, v) };
     let u: Vec2 = sampler.next_2d();
     // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).
     if depth.saturating_add(1) >= max_depth {

@@ -61,6 +61,8 @@ pub struct Snee {
     /// Per medium: its flat rough boundary where the manifold connection applies
     /// (`connection = complete`, `manifold::rough::rough_boundaries`; empty with `paper`).
     pub rough: Vec<Option<crate::integrator::manifold::rough::RoughBoundary>>,
+    /// Per medium: does the curved connection apply (`manifold::curved::curved_boundaries`)?
+    pub curved: Vec<bool>,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).

@@ -1,0 +1,249 @@
+//! Manifold NEE through a CURVED smooth boundary (`connection = complete`): media enclosed by
+//! smooth `dielectric` triangle meshes with interpolated shading normals (e.g. the paper's statue)
+//! or analytic spheres, under a DIRECTIONAL light (docs/manifold.md §8).
+//!
+//! From the medium vertex `x_j` the connection seeds the direction from the straight line towards
+//! the light (Hanika et al. 2015 §3; [`newton::refracted_seed`]), solves the refraction constraint by Newton
+//! iteration on the boundary ([`newton::solve`]; the walk across triangles is the ray cast of
+//! each step), verifies the solution (the first hit from `x_j` is `x_k` on the enclosing
+//! boundary, seen from inside, the light leaves on the outside of both the geometric and the
+//! shading normal, the light segment is passable) and returns
+//!
+//! ```text
+//! f_p(wi_j, omega) · T(d_jk) · (1 − F) η² · dω/dω_l · tr_light · E / p_sel
+//! ```
+//!
+//! (the radiance through the interface is `(1 − F) η² L`, docs/manifold.md §3; integrating the
+//! Dirac `δ(o(omega) − omega_l)` over the directions at `x_j` gives `1/|det dω_l/dω|`, the beam
+//! spread through the curved surface; on a flat facet it is `cos θ_l / (η² cos θ_in)`).
+//!
+//! **MIS: a partition.** Under a directional light behind a smooth boundary only SNEE (at the
+//! previous vertex `x_i`) and this connection make a suffix `x_j → x_k → light`. The connection
+//! finds one solution per seed and has no closed-form density, so instead of the power heuristic
+//! the suffixes are partitioned: SNEE keeps every suffix in its support (its density `pdf_snee >
+//! 0`: `x_i` a SNEE vertex in the same medium, `x_k` visible from `x_i`), with its own weight
+//! unchanged; the connection takes the rest (single scattering, a surface event before `x_j`,
+//! `x_k` hidden from `x_i`, SNEE's depth budget), and all of them with `snee = forward`. Unbiased
+//! whenever each technique is unbiased on its part; what the single Newton seed misses is
+//! measured in the tests (docs/manifold.md §8). Environments, area and point lights through a
+//! curved boundary are not connected (weight 0 here: the other techniques' weights stand).
+
+use super::newton::{self, Locate, Patch, Surface};
+use super::{light_segment, MediumVertex};
+use crate::bsdf::fresnel::fresnel;
+use crate::bsdf::Bsdf;
+use crate::color::Spectrum;
+use crate::emitter::Emitter;
+use crate::integrator::cx::{Cx, Scatter};
+use crate::integrator::snee::{self, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
+use crate::integrator::stats::LocalStats;
+use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
+use crate::math::{DVec3, Ray, Vec2, Vec3};
+use crate::sampler::Sampler;
+use crate::scene::world::{Scene, SceneEmitter};
+use crate::shape::Geometry;
+
+/// Per medium of `scene`: does the curved connection apply (a smooth `dielectric` boundary made
+/// of meshes and spheres, not flat — flat boundaries take the closed form of `flat.rs`)?
+/// Only scenes with a directional light: elsewhere the connection would draw samples and
+/// contribute nothing (and `complete` renders bit for bit what `paper` renders).
+pub fn curved_boundaries(scene: &Scene, flat: &[Option<super::planes::FlatBoundary>]) -> Vec<bool> {
+    let lit = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_))));
+    (0..scene.media.len())
+        .map(|m| lit && flat.get(m).is_none_or(|f| f.is_none()) && curved_boundary(scene, m as u32))
+        .collect()
+}
+
+fn curved_boundary(scene: &Scene, medium: u32) -> bool {
+    if !scene.media[medium as usize].sample_emitters {
+        return false;
+    }
+    let mut enclosed = false;
+    for s in scene.shapes.iter().filter(|s| s.interior == Some(medium) && s.exterior.is_none()) {
+        match &scene.bsdfs[s.bsdf as usize] {
+            Bsdf::Dielectric(_) => {}
+            Bsdf::RoughDielectric(_) => return false,
+            _ => continue,
+        }
+        match &s.geometry {
+            Geometry::Mesh(_) | Geometry::Sphere(_) => enclosed = true,
+            _ => return false,
+        }
+    }
+    enclosed
+}
+
+/// Does the curved connection run for `medium`?
+#[inline]
+pub fn applies(scene: &Scene, medium: u32) -> bool {
+    super::tables(scene).and_then(|t| t.curved.get(medium as usize).copied()).unwrap_or(false)
+}
+
+/// The scene as the Newton walk sees it: each step's ray cast from `x_j`, accepted when the first
+/// hit is `medium`'s enclosing smooth dielectric, met from inside.
+struct SceneLocate<'a> {
+    scene: &'a Scene,
+    medium: u32,
+    rays: u64,
+}
+
+impl Locate for SceneLocate<'_> {
+    fn locate(&mut self, o: DVec3, d: DVec3) -> Option<Patch> {
+        self.rays += 1;
+        let si = self.scene.ray_intersect(&Ray::new(o.as_vec3(), d.as_vec3().normalize()))?;
+        boundary_patch(self.scene, &si, self.medium, d.as_vec3())
+    }
+}
+
+/// The closed-form patch of the boundary hit `si` (reached from inside `medium` along `d`).
+fn boundary_patch(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3) -> Option<Patch> {
+    let s = &scene.shapes[si.shape as usize];
+    if s.interior != Some(medium) || s.exterior.is_some() || !(d.dot(si.n) > 0.0) {
+        return None;
+    }
+    let Bsdf::Dielectric(b) = scene.bsdf(si) else { return None };
+    let surface = match &s.geometry {
+        Geometry::Mesh(mesh) => {
+            let p = mesh.vertices(si.prim).map(|v| v.as_dvec3());
+            let sign = if mesh.flip_normals { -1.0 } else { 1.0 };
+            let n = if mesh.normals.is_empty() {
+                [si.n.as_dvec3(); 3]
+            } else {
+                mesh.indices[si.prim as usize].map(|i| mesh.normals[i as usize].as_dvec3() * sign)
+            };
+            Surface::Triangle { p, n }
+        }
+        Geometry::Sphere(sp) => Surface::Sphere {
+            center: sp.center.as_dvec3(),
+            radius: sp.radius as f64,
+            outward: if sp.flip_normals { -1.0 } else { 1.0 },
+        },
+        _ => return None,
+    };
+    Some(Patch { surface, eta: b.eta as f64 })
+}
+
+/// A verified connection: its value (without the path throughput and the MIS weight) and `x_k`.
+#[derive(Clone, Copy, Debug)]
+pub struct CurvedConnection {
+    pub value: Spectrum,
+    pub si_k: SurfaceInteraction,
+    pub omega: Vec3,
+}
+
+/// Sample one solution of the connection from `x_j` to a light in the direction `omega_l`
+/// (weight `E / p_sel`) with specular manifold sampling's unbiased `1/p` estimate
+/// ([`newton::sample_solution`]), verify it, and return `f(s) · N` (docs/manifold.md §8). Counts
+/// solves, iterations, failures.
+pub fn connect(
+    scene: &Scene,
+    x_j: &MediumVertex,
+    omega_l: Vec3,
+    weight: Spectrum,
+    sampler: &mut Sampler,
+    stats: &mut LocalStats,
+) -> Option<CurvedConnection> {
+    let mut locate = SceneLocate { scene, medium: x_j.medium, rays: 0 };
+    let mut counts = newton::SolveCounts::default();
+    let mut u = || sampler.next_1d() as f64;
+    let sampled = newton::sample_solution(&mut locate, x_j.p.as_dvec3(), omega_l.as_dvec3(), &mut u, &mut counts);
+    stats.rays += locate.rays;
+    stats.manifold_newton_solves += counts.solves;
+    stats.manifold_newton_iterations += counts.iterations;
+    stats.manifold_newton_failures += counts.no_convergence;
+    stats.manifold_newton_lost += counts.lost;
+    stats.manifold_trials_capped += counts.capped;
+    let Some((sol, trials)) = sampled else {
+        stats.manifold_failures += 1;
+        return None;
+    };
+    // Verify in the renderer's own precision: the first hit along the solution is x_k, on the
+    // enclosing boundary from inside; the light leaves outside both normals there.
+    let omega = sol.omega.as_vec3().normalize();
+    stats.rays += 1;
+    let verified = scene.ray_intersect(&Ray::new(x_j.p, omega)).filter(|si| {
+        boundary_patch(scene, si, x_j.medium, omega).is_some()
+            && si.n.dot(omega_l) > 0.0
+            && si.sh_frame.n.dot(omega_l) > 0.0
+            && (si.p.as_dvec3() - sol.refracted.x_k).length() <= 1e-3 * (1.0 + sol.refracted.t)
+            && si.sh_frame.n.as_dvec3().dot(sol.refracted.n_s) > 1.0 - 1e-4
+    });
+    let Some(si_k) = verified else {
+        stats.manifold_failures += 1;
+        return None;
+    };
+    let tr_out = light_segment(scene, &si_k, omega_l, stats);
+    if tr_out == Spectrum::ZERO {
+        stats.manifold_failures += 1;
+        return None;
+    }
+    stats.manifold_solutions += 1;
+    let m = &scene.media[x_j.medium as usize];
+    let eta = sol.patch.eta as f32;
+    let f = fresnel(sol.refracted.cos_out as f32, eta).0;
+    let spread = ((1.0 - f) * eta * eta) as f64 * sol.d_omega_d_omega_l;
+    let value =
+        m.phase.eval(x_j.wi, omega) * m.transmittance(si_k.t) * tr_out * weight * (spread * trials as f64) as f32;
+    Some(CurvedConnection { value, si_k, omega })
+}
+
+/// Is the suffix `x_i → x_j → x_k → light` in SNEE's support (SNEE's density positive)? The
+/// partition of this file's MIS: such suffixes are SNEE's alone.
+#[allow(clippy::too_many_arguments)]
+fn in_snee_support(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    si_k: &SurfaceInteraction,
+    light: &LightSample,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> bool {
+    let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) else {
+        return false;
+    };
+    let Some(tables) = super::tables(scene) else { return false };
+    let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
+    if !(snee::pdf_snee(scene, tables, &suffix, light, channel) > 0.0) {
+        return false;
+    }
+    stats.rays += 1;
+    let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
+    !scene.ray_test(&spawn_ray_between(x_i.p, inner_k))
+}
+
+/// The curved connection at a real scatter `v` (`x_j = v.p`), or `None` where it does not run
+/// (then the caller's flat connection did not run either). Draws one 2-D sample when it runs.
+pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scatter) -> Option<Spectrum> {
+    let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
+    if !applies(scene, v.medium) {
+        return None;
+    }
+    let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
+    let u: Vec2 = sampler.next_2d();
+    if v.depth.saturating_add(1) >= v.max_depth {
+        return None;
+    }
+    stats.manifold_attempts += 1;
+    // The same emitter choice as the flat connection: only directional lights are connected here.
+    if !matches!(super::finite::pick(scene, u), super::finite::Pick::Distant) {
+        return Some(Spectrum::ZERO);
+    }
+    let (ds, weight) = scene.sample_emitter_direction(x_j.p, None, u, false);
+    if !(ds.pdf > 0.0) || ds.dist.is_finite() || !ds.delta || weight == Spectrum::ZERO {
+        return Some(Spectrum::ZERO);
+    }
+    let Some(c) = connect(scene, &x_j, ds.d, weight, sampler, stats) else { return Some(Spectrum::ZERO) };
+    let light = LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: true, le: Spectrum::ZERO };
+    if !opts.keeps_all() || in_snee_support(scene, opts, x_i, &x_j, &c.si_k, &light, channel, stats) {
+        return Some(Spectrum::ZERO);
+    }
+    let contribution = v.beta * c.value;
+    if crate::color::is_finite(contribution) {
+        Some(contribution)
+    } else {
+        stats.rejected_samples += 1;
+        Some(Spectrum::ZERO)
+    }
+}
