@@ -213,6 +213,7 @@ impl Bsdf {
     }
 
     /// Flags of component `i` (0 when out of range).
+    #[inline]
     pub fn component_flags(&self, i: u32) -> u32 {
         match self {
             Bsdf::Diffuse(_) => diffuse::component_flags(i),
@@ -229,9 +230,20 @@ impl Bsdf {
         }
     }
 
-    /// Union of all component flags (Mitsuba's `BSDF::flags()`).
+    /// Union of all component flags (Mitsuba's `BSDF::flags()`). Asked at every surface vertex:
+    /// the leaf BSDFs have at most two lobes (and flags 0 past their last), so their union is
+    /// that of lobes 0 and 1, without the loop.
+    #[inline]
     pub fn flags(&self) -> u32 {
-        (0..self.component_count()).fold(0, |acc, i| acc | self.component_flags(i))
+        match self {
+            Bsdf::TwoSided(..) | Bsdf::Mask(_) | Bsdf::RoughDielectric(_) | Bsdf::RoughConductor(_) => {
+                (0..self.component_count()).fold(0, |acc, i| acc | self.component_flags(i))
+            }
+            _ => {
+                debug_assert!(self.component_count() <= 2);
+                self.component_flags(0) | self.component_flags(1)
+            }
+        }
     }
 
     /// True when some lobe of the given type(s) exists.
