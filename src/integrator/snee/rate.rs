@@ -12,7 +12,14 @@ pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
         SceneEmitter::Area { .. } => true,
         SceneEmitter::Other(e) => !e.is_delta(),
     });
-    Snee { options, rates: medium_rates(scene, options), has_non_delta_emitter, flat: Vec::new(), rough: Vec::new(), curved: Vec::new() }
+    Snee {
+        options,
+        rates: medium_rates(scene, options),
+        has_non_delta_emitter,
+        flat: Vec::new(),
+        rough: Vec::new(),
+        curved: Vec::new(),
+    }
 }
 
 /// Per medium of `scene`: `None` where SNEE does not apply (the medium does not sample emitters,
