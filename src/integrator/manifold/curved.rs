@@ -29,7 +29,7 @@
 //! curved boundary are not connected (weight 0 here: the other techniques' weights stand).
 
 use super::newton::{self, Locate, Patch, Surface};
-use super::{light_segment, MediumVertex};
+use super::{verified_light_segment, MediumVertex};
 use crate::bsdf::fresnel::fresnel;
 use crate::bsdf::Bsdf;
 use crate::color::Spectrum;
@@ -172,12 +172,7 @@ pub fn connect(
         stats.manifold_failures += 1;
         return None;
     };
-    let tr_out = light_segment(scene, &si_k, omega_l, stats);
-    if tr_out == Spectrum::ZERO {
-        stats.manifold_failures += 1;
-        return None;
-    }
-    stats.manifold_solutions += 1;
+    let tr_out = verified_light_segment(scene, &si_k, omega_l, stats)?;
     let m = &scene.media[x_j.medium as usize];
     let eta = sol.patch.eta as f32;
     let f = fresnel(sol.refracted.cos_out as f32, eta).0;
@@ -239,11 +234,7 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     if !opts.keeps_all() || in_snee_support(scene, opts, x_i, &x_j, &c.si_k, &light, channel, stats) {
         return Some(Spectrum::ZERO);
     }
-    let contribution = v.beta * c.value;
-    if crate::color::is_finite(contribution) {
-        Some(contribution)
-    } else {
-        stats.rejected_samples += 1;
-        Some(Spectrum::ZERO)
-    }
+    let mut result = Spectrum::ZERO;
+    super::add_finite(&mut result, v.beta * c.value, stats);
+    Some(result)
 }

@@ -28,6 +28,41 @@ pub fn flat_boundaries(scene: &Scene) -> Vec<Option<FlatBoundary>> {
     (0..scene.media.len() as u32).map(|m| if lit { flat_boundary(scene, m) } else { None }).collect()
 }
 
+/// A boundary triangle's outward face normal, if the mesh is flat-shaded there.
+pub(super) enum FaceNormal {
+    /// Every vertex normal (if any) equals the face normal `n` (flip_normals applied).
+    Flat(Vec3),
+    /// Zero area: never hit, ignored.
+    Degenerate,
+    /// Interpolated normals differ from the face normal: not a flat facet.
+    Curved,
+}
+
+/// The face normal of triangle `prim` (vertex indices `idx`) of `mesh`, and whether the mesh is
+/// flat-shaded there (shared by the smooth and the rough flat boundaries).
+pub(super) fn flat_face_normal(mesh: &crate::shape::mesh::Mesh, prim: usize, idx: &[u32; 3]) -> FaceNormal {
+    let [p0, p1, p2] = mesh.vertices(prim as u32);
+    let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+    if n == Vec3::ZERO {
+        return FaceNormal::Degenerate;
+    }
+    if mesh.flip_normals {
+        n = -n;
+    }
+    // Flat shading: every vertex normal equals the face normal.
+    let flat = mesh.normals.is_empty()
+        || idx.iter().all(|&i| {
+            let vn = mesh.normals[i as usize];
+            let vn = if mesh.flip_normals { -vn } else { vn };
+            vn.dot(n) > SAME_NORMAL
+        });
+    if flat {
+        FaceNormal::Flat(n)
+    } else {
+        FaceNormal::Curved
+    }
+}
+
 fn flat_boundary(scene: &Scene, medium: u32) -> Option<FlatBoundary> {
     if !scene.media[medium as usize].sample_emitters {
         return None;
@@ -44,25 +79,12 @@ fn flat_boundary(scene: &Scene, medium: u32) -> Option<FlatBoundary> {
         let Geometry::Mesh(mesh) = &s.geometry else { return None };
         enclosed = true;
         for (prim, idx) in mesh.indices.iter().enumerate() {
-            let [p0, p1, p2] = mesh.vertices(prim as u32);
-            let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-            if n == Vec3::ZERO {
-                continue; // degenerate: never hit
-            }
-            if mesh.flip_normals {
-                n = -n;
-            }
-            // Flat shading: every vertex normal equals the face normal.
-            if !mesh.normals.is_empty() {
-                let flat = idx.iter().all(|&i| {
-                    let vn = mesh.normals[i as usize];
-                    let vn = if mesh.flip_normals { -vn } else { vn };
-                    vn.dot(n) > SAME_NORMAL
-                });
-                if !flat {
-                    return None;
-                }
-            }
+            let p0 = mesh.vertices(prim as u32)[0];
+            let n = match flat_face_normal(mesh, prim, idx) {
+                FaceNormal::Flat(n) => n,
+                FaceNormal::Degenerate => continue, // never hit
+                FaceNormal::Curved => return None,
+            };
             if !planes.iter().any(|q| q.eta == eta && q.n.dot(n) > SAME_NORMAL) {
                 planes.push(Plane { n, eta });
                 if planes.len() > MAX_PLANES {

@@ -88,24 +88,48 @@ pub fn suffix_pdfs(
     let omega_jk = v / d_jk;
     let st = m.sigma_t[channel] as f64;
     let forward = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp() * (1.0 - r.fresnel as f64);
-    let mut snee = 0.0;
-    if let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) {
-        let visible = !check_support || {
-            stats.rays += 1;
-            let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
-            !scene.ray_test(&spawn_ray_between(x_i.p, inner_k))
-        };
-        if let (true, Some(tables)) = (visible, super::tables(scene)) {
-            let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
-            let pdf_snee = snee::pdf_snee(scene, tables, &suffix, light, channel);
-            let to_sa = p_volume(scene, x_i, x_j.p, channel) * r.cos_in as f64 / (d_jk as f64 * d_jk as f64);
-            if to_sa > 0.0 {
-                snee = pdf_snee / to_sa;
-            }
-        }
-    }
+    let snee =
+        snee_solid_angle_pdf(scene, opts, x_i, x_j, si_k, light, channel, check_support, r.cos_in as f64, d_jk, stats);
     let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
     EnvPdfs { manifold: finite(manifold), forward: finite(forward), snee: finite(snee) }
+}
+
+/// SNEE's density of the suffix `x_i → x_j → x_k → light`, in the solid angle of `omega_jk` at
+/// `x_j` conditioned on `x_j` (docs/manifold.md §4.2: its `dV(x_j) dA(x_k)` density divided by
+/// forward's volume density of `x_j` and by `dA(x_k)/dω_jk = d_jk²/cos_k`); 0 where SNEE cannot make
+/// it (no SNEE vertex `x_i` in the same medium, `snee = forward`, or, with `check_support`, `x_k`
+/// hidden from `x_i`: one shadow ray). `cos_k`: |cos| of `omega_jk` at `x_k`.
+#[allow(clippy::too_many_arguments)]
+pub fn snee_solid_angle_pdf(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    si_k: &SurfaceInteraction,
+    light: &LightSample,
+    channel: usize,
+    check_support: bool,
+    cos_k: f64,
+    d_jk: f32,
+    stats: &mut LocalStats,
+) -> f64 {
+    let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) else {
+        return 0.0;
+    };
+    let visible = !check_support || {
+        stats.rays += 1;
+        let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
+        !scene.ray_test(&spawn_ray_between(x_i.p, inner_k))
+    };
+    let Some(tables) = super::tables(scene).filter(|_| visible) else { return 0.0 };
+    let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
+    let pdf_snee = snee::pdf_snee(scene, tables, &suffix, light, channel);
+    let to_sa = p_volume(scene, x_i, x_j.p, channel) * cos_k / (d_jk as f64 * d_jk as f64);
+    if to_sa > 0.0 {
+        pdf_snee / to_sa
+    } else {
+        0.0
+    }
 }
 
 /// Which technique made the suffix.
@@ -120,24 +144,35 @@ pub enum EnvTechnique {
 /// (`snee = mis`); `snee = snee`: SNEE takes what it can make, the other two share the rest;
 /// `snee = forward`: SNEE's density is 0. `transport = snee`: suffixes outside SNEE's support get 0.
 pub fn env_weight(opts: SneeOptions, technique: EnvTechnique, p: EnvPdfs) -> f64 {
-    let s = if opts.technique == SneeTechnique::Forward { 0.0 } else { p.snee };
+    let own = match technique {
+        EnvTechnique::Manifold => Some(p.manifold),
+        EnvTechnique::Forward => Some(p.forward),
+        EnvTechnique::Snee => None,
+    };
+    power_weight(opts, own, &[p.manifold, p.forward], p.snee)
+}
+
+/// The power heuristic over a set of techniques one of which is SNEE, with the conventions of
+/// the `snee` and `transport` options (shared by [`env_weight`] and `rough::rough_weight`):
+/// `own` is the density of the technique that made the suffix (`None`: SNEE made it), `others`
+/// the densities of the techniques other than SNEE, `snee` SNEE's. `snee = forward`: SNEE's density
+/// is 0; `snee = snee`: SNEE takes what it can make; `transport = snee`: suffixes outside SNEE's
+/// support get 0.
+pub fn power_weight(opts: SneeOptions, own: Option<f64>, others: &[f64], snee: f64) -> f64 {
+    let s = if opts.technique == SneeTechnique::Forward { 0.0 } else { snee };
     if opts.transport == SneeTransport::Snee && s == 0.0 {
         return 0.0;
     }
     if opts.technique == SneeTechnique::Snee && s > 0.0 {
-        return if technique == EnvTechnique::Snee { 1.0 } else { 0.0 };
+        return if own.is_none() { 1.0 } else { 0.0 };
     }
-    let own = match technique {
-        EnvTechnique::Manifold => p.manifold,
-        EnvTechnique::Forward => p.forward,
-        EnvTechnique::Snee => s,
-    };
+    let own = own.unwrap_or(s);
     if !(own > 0.0) {
         return 0.0;
     }
     // Ratios against the own density avoid overflow of the squares.
-    let (a, b, c) = (p.manifold / own, p.forward / own, s / own);
-    let w = 1.0 / (a * a + b * b + c * c);
+    let sum = others.iter().fold(0.0, |acc, p| acc + (p / own) * (p / own)) + (s / own) * (s / own);
+    let w = 1.0 / sum;
     if w.is_finite() {
         w
     } else {

@@ -156,12 +156,7 @@ pub fn connect(
             return None;
         }
     };
-    let tr_out = light_segment(scene, &si_k, omega_l, stats);
-    if tr_out == Spectrum::ZERO {
-        stats.manifold_failures += 1;
-        return None;
-    }
-    stats.manifold_solutions += 1;
+    let tr_out = verified_light_segment(scene, &si_k, omega_l, stats)?;
     let m = &scene.media[x_j.medium as usize];
     let d_jk = si_k.t;
     let value = m.phase.eval(x_j.wi, d)
@@ -226,14 +221,36 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
                 LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: true, le: Spectrum::ZERO };
             weight_against_snee(scene, opts, x_i, &x_j, &c.suffix, &light, channel, stats)
         };
-        let contribution = beta * c.value * w as f32;
-        if crate::color::is_finite(contribution) {
-            result += contribution;
-        } else {
-            stats.rejected_samples += 1;
-        }
+        add_finite(&mut result, beta * c.value * w as f32, stats);
     }
     Some(result)
+}
+
+/// The light segment from a verified `x_k` ([`light_segment`]): counts the connection as a
+/// solution, or as a failure (`None`) when the segment is blocked.
+pub(super) fn verified_light_segment(
+    scene: &Scene,
+    si_k: &SurfaceInteraction,
+    omega_l: Vec3,
+    stats: &mut LocalStats,
+) -> Option<Spectrum> {
+    let tr_out = light_segment(scene, si_k, omega_l, stats);
+    if tr_out == Spectrum::ZERO {
+        stats.manifold_failures += 1;
+        return None;
+    }
+    stats.manifold_solutions += 1;
+    Some(tr_out)
+}
+
+/// Adds a connection's `contribution` to `result`, or counts it as a rejected sample when it is
+/// not finite (no NaN or Inf reaches the film).
+pub(crate) fn add_finite(result: &mut Spectrum, contribution: Spectrum, stats: &mut LocalStats) {
+    if crate::color::is_finite(contribution) {
+        *result += contribution;
+    } else {
+        stats.rejected_samples += 1;
+    }
 }
 
 /// The manifold stage's connections to a light point at a finite distance (`lp`), one per
@@ -265,12 +282,7 @@ fn sample_finite(
                 ManifoldSuffix { si_k: c.si_k, refraction: c.refraction, plane: s.plane, d_jk: c.d_jk, jacobian };
             weight_against_snee(scene, opts, x_i, x_j, &suffix, &c.light, channel, stats)
         };
-        let contribution = beta * c.value * w as f32;
-        if crate::color::is_finite(contribution) {
-            result += contribution;
-        } else {
-            stats.rejected_samples += 1;
-        }
+        add_finite(&mut result, beta * c.value * w as f32, stats);
     }
     result
 }

@@ -37,9 +37,9 @@ use crate::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use crate::color::Spectrum;
 use crate::integrator::cx::{Cx, Scatter};
 use crate::integrator::snee::SneeVertex;
-use crate::integrator::snee::{self, with_wi, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeTransport};
+use crate::integrator::snee::{with_wi, LightSample, SneeOptions, SneeSuffix, SneeTechnique};
 use crate::integrator::stats::LocalStats;
-use crate::interaction::{offset_origin, spawn_ray_between, DirectionSample, SurfaceInteraction};
+use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::{Frame, Ray, Vec2, Vec3};
 use crate::scene::world::Scene;
 use crate::shape::Geometry;
@@ -88,24 +88,11 @@ fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
         let Geometry::Mesh(mesh) = &s.geometry else { return None };
         enclosed = true;
         for (prim, idx) in mesh.indices.iter().enumerate() {
-            let [p0, p1, p2] = mesh.vertices(prim as u32);
-            let mut n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-            if n == Vec3::ZERO {
-                continue;
-            }
-            if mesh.flip_normals {
-                n = -n;
-            }
-            if !mesh.normals.is_empty() {
-                let flat = idx.iter().all(|&i| {
-                    let vn = mesh.normals[i as usize];
-                    let vn = if mesh.flip_normals { -vn } else { vn };
-                    vn.dot(n) > SAME_NORMAL
-                });
-                if !flat {
-                    return None;
-                }
-            }
+            let n = match super::flat::flat_face_normal(mesh, prim, idx) {
+                super::flat::FaceNormal::Flat(n) => n,
+                super::flat::FaceNormal::Degenerate => continue,
+                super::flat::FaceNormal::Curved => return None,
+            };
             if !planes.iter().any(|q| q.bsdf == s.bsdf && q.n.dot(n) > SAME_NORMAL) {
                 planes.push(RoughPlane { n, bsdf: s.bsdf });
                 if planes.len() > MAX_PLANES {
@@ -228,23 +215,20 @@ pub fn rough_pdfs(
     } else {
         0.0
     };
-    let mut snee = 0.0;
-    if let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) {
-        let visible = !check_support || {
-            stats.rays += 1;
-            let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
-            !scene.ray_test(&spawn_ray_between(x_i.p, inner_k))
-        };
-        if let (true, Some(tables)) = (visible, super::tables(scene)) {
-            let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
-            let pdf_snee = snee::pdf_snee(scene, tables, &suffix, light, channel);
-            let cos_k = omega_jk.dot(si_k.n).abs() as f64;
-            let to_sa = super::mis::p_volume(scene, x_i, x_j.p, channel) * cos_k / (d_jk as f64 * d_jk as f64);
-            if to_sa > 0.0 {
-                snee = pdf_snee / to_sa;
-            }
-        }
-    }
+    let cos_k = omega_jk.dot(si_k.n).abs() as f64;
+    let snee = super::mis::snee_solid_angle_pdf(
+        scene,
+        opts,
+        x_i,
+        x_j,
+        si_k,
+        light,
+        channel,
+        check_support,
+        cos_k,
+        d_jk,
+        stats,
+    );
     let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
     RoughPdfs { manifold: finite(manifold), fwd_nee: finite(fwd_nee), fwd_bsdf: finite(fwd_bsdf), snee: finite(snee) }
 }
@@ -262,30 +246,13 @@ pub enum RoughTechnique {
 /// (`snee = mis`); `snee = snee`: SNEE takes what it can make, the others share the rest;
 /// `snee = forward`: SNEE's density is 0. `transport = snee`: suffixes outside SNEE's support get 0.
 pub fn rough_weight(opts: SneeOptions, technique: RoughTechnique, p: RoughPdfs) -> f64 {
-    let s = if opts.technique == SneeTechnique::Forward { 0.0 } else { p.snee };
-    if opts.transport == SneeTransport::Snee && s == 0.0 {
-        return 0.0;
-    }
-    if opts.technique == SneeTechnique::Snee && s > 0.0 {
-        return if technique == RoughTechnique::Snee { 1.0 } else { 0.0 };
-    }
     let own = match technique {
-        RoughTechnique::Manifold => p.manifold,
-        RoughTechnique::FwdNee => p.fwd_nee,
-        RoughTechnique::FwdBsdf => p.fwd_bsdf,
-        RoughTechnique::Snee => s,
+        RoughTechnique::Manifold => Some(p.manifold),
+        RoughTechnique::FwdNee => Some(p.fwd_nee),
+        RoughTechnique::FwdBsdf => Some(p.fwd_bsdf),
+        RoughTechnique::Snee => None,
     };
-    if !(own > 0.0) {
-        return 0.0;
-    }
-    // Ratios against the own density avoid overflow of the squares.
-    let (a, b, c, d) = (p.manifold / own, p.fwd_nee / own, p.fwd_bsdf / own, s / own);
-    let w = 1.0 / (a * a + b * b + c * c + d * d);
-    if w.is_finite() {
-        w
-    } else {
-        0.0
-    }
+    super::mis::power_weight(opts, own, &[p.manifold, p.fwd_nee, p.fwd_bsdf], p.snee)
 }
 
 /// One verified connection through a rough plane.
@@ -371,12 +338,7 @@ pub fn sample(
             continue;
         }
         // E / p_sel or L / p_env (weight) · w / p_imp, with p_man = p_light · p_imp.
-        let contribution = v.beta * c.f * weight * (w * ds.pdf as f64 / p.manifold) as f32;
-        if crate::color::is_finite(contribution) {
-            result += contribution;
-        } else {
-            stats.rejected_samples += 1;
-        }
+        super::add_finite(&mut result, v.beta * c.f * weight * (w * ds.pdf as f64 / p.manifold) as f32, stats);
     }
     Some(result)
 }
