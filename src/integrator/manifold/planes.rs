@@ -1,6 +1,6 @@
-//! The planes of a flat boundary as plain data (the scene's `volpath_snee` tables store them, so
-//! this file imports nothing of the scene): orientations, supporting planes, and the lookup of the
-//! plane through a boundary point. Finding them in a scene is `flat.rs`.
+//! The planes of flat boundaries as plain data, smooth (found by `flat.rs`) and rough (found by
+//! `rough.rs`): the scene's `volpath_snee` tables store them, so this file imports nothing of the
+//! scene. Orientations, supporting planes, and the lookup of the plane through a boundary point.
 
 use crate::math::Vec3;
 
@@ -46,4 +46,25 @@ impl FlatBoundary {
 #[inline]
 pub(super) fn same_offset(a: f32, b: f32) -> bool {
     (a - b).abs() <= 1e-4 * (1.0 + a.abs().max(b.abs()))
+}
+
+/// One orientation of a rough boundary: outward unit normal and the `roughdielectric` (index into
+/// `Scene::bsdfs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoughPlane {
+    pub n: Vec3,
+    pub bsdf: u32,
+}
+
+/// The flat rough boundary of one medium: its distinct (normal, BSDF) orientations.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RoughBoundary {
+    pub planes: Vec<RoughPlane>,
+}
+
+impl RoughBoundary {
+    /// The orientation with geometric normal `n` and BSDF `bsdf`.
+    pub fn plane_at(&self, n: Vec3, bsdf: u32) -> Option<&RoughPlane> {
+        self.planes.iter().find(|p| p.bsdf == bsdf && p.n.dot(n) > SAME_NORMAL)
+    }
 }

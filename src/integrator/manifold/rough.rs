@@ -44,26 +44,7 @@ use crate::math::{Frame, Ray, Vec2, Vec3};
 use crate::scene::world::Scene;
 use crate::shape::Geometry;
 
-/// One orientation of a rough boundary: outward unit normal and the `roughdielectric` (index into
-/// `Scene::bsdfs`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoughPlane {
-    pub n: Vec3,
-    pub bsdf: u32,
-}
-
-/// The flat rough boundary of one medium: its distinct (normal, BSDF) orientations.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct RoughBoundary {
-    pub planes: Vec<RoughPlane>,
-}
-
-impl RoughBoundary {
-    /// The orientation with geometric normal `n` and BSDF `bsdf`.
-    pub fn plane_at(&self, n: Vec3, bsdf: u32) -> Option<&RoughPlane> {
-        self.planes.iter().find(|p| p.bsdf == bsdf && p.n.dot(n) > SAME_NORMAL)
-    }
-}
+pub use super::planes::{RoughBoundary, RoughPlane};
 
 /// Per medium of `scene`: its flat rough boundary, or `None` (no emitter, the medium does not sample
 /// emitters, or some enclosing shape is not a flat-shaded mesh with an isotropic `roughdielectric`,

@@ -60,7 +60,7 @@ pub struct Snee {
     pub flat: Vec<Option<crate::integrator::manifold::planes::FlatBoundary>>,
     /// Per medium: its flat rough boundary where the manifold connection applies
     /// (`connection = complete`, `manifold::rough::rough_boundaries`; empty with `paper`).
-    pub rough: Vec<Option<crate::integrator::manifold::rough::RoughBoundary>>,
+    pub rough: Vec<Option<crate::integrator::manifold::planes::RoughBoundary>>,
     /// Per medium: does the curved connection apply (`manifold::curved::curved_boundaries`)?
     pub curved: Vec<bool>,
 }
