@@ -222,7 +222,7 @@ pub fn recompute_vertex_normals(positions: &[Vec3], indices: &[[u32; 3]], face_n
             // Unit edges e01, e12, e20; corner k's edges are e_k(k+1) and −e_(k+2)k.
             let (e01, e12, e20) =
                 ((p1 - p0).normalize_or_zero(), (p2 - p1).normalize_or_zero(), (p0 - p2).normalize_or_zero());
-            [-e01.dot(e20), -e12.dot(e01), -e20.dot(e12)].map(acos)
+            [-e01.dot(e20), -e12.dot(e01), -e20.dot(e12)].map(crate::math::fast::acos)
         })
         .collect();
     let mut normals = vec![Vec3::ZERO; positions.len()];
@@ -241,31 +241,6 @@ pub fn recompute_vertex_normals(positions: &[Vec3], indices: &[[u32; 3]], face_n
         *n = if l > 0.0 { *n / l } else { Vec3::Z };
     });
     normals
-}
-
-/// `acos(x)` for x in [−1, 1] (clamped; NaN stays NaN) within 2 ulp, without a libm call:
-/// Cephes' `asinf` polynomial (as Dr.Jit's `acos`, which Mitsuba's normals use), on
-/// `asin(x)` for |x| ≤ 1/2 and on `2 asin(√((1 − |x|) / 2))` above.
-#[inline(always)]
-pub fn acos(x: f32) -> f32 {
-    let x = x.clamp(-1.0, 1.0);
-    let a = x.abs();
-    let big = a > 0.5;
-    let z = if big { 0.5 * (1.0 - a) } else { a * a };
-    let s = if big { z.sqrt() } else { a };
-    let p = (((4.216_32e-2 * z + 2.418_131_2e-2) * z + 4.547_002_6e-2) * z + 7.495_300_3e-2) * z + 1.666_675_2e-1;
-    // asin(s) for s in [0, 1/2].
-    let asin_s = s + s * z * p;
-    if big {
-        let r = 2.0 * asin_s;
-        if x < 0.0 {
-            std::f32::consts::PI - r
-        } else {
-            r
-        }
-    } else {
-        std::f32::consts::FRAC_PI_2 - asin_s.copysign(x)
-    }
 }
 
 /// A mesh loaded from a file (`obj`, `ply`, `serialized`): the `filename` and `face_normals`
@@ -288,22 +263,4 @@ pub fn from_file_props(
         _ => serialized::from_props(props, &path)?,
     };
     Ok(Geometry::Mesh(Mesh::new(data, to_world, face_normals, flip_normals)))
-}
-
-#[cfg(test)]
-mod tests {
-    /// The polynomial `acos` agrees with libm's within 2 ulp of π (on a fine grid and the ends).
-    #[test]
-    fn acos_matches_libm() {
-        let n = 200_000;
-        let mut worst = 0.0f32;
-        for i in 0..=n {
-            let x = -1.0 + 2.0 * i as f32 / n as f32;
-            worst = worst.max((super::acos(x) - x.acos()).abs());
-        }
-        assert!(worst <= 2.0 * f32::EPSILON * std::f32::consts::PI, "max error {worst}");
-        assert_eq!(super::acos(1.0), 0.0);
-        assert_eq!(super::acos(-1.0), std::f32::consts::PI);
-        assert!(super::acos(f32::NAN).is_nan());
-    }
 }
