@@ -174,16 +174,16 @@ pub fn connect(
 /// against forward tracing. `None` when the connection does not run here (then its density is 0
 /// for suffixes from `x_j`); it draws one 2-D sample whenever it runs.
 pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scatter) -> Option<Spectrum> {
+    if !enabled(cx.scene) {
+        return None;
+    }
     // A flat rough boundary: its own connection (`rough.rs`).
-    if let Some(rb) = enabled(cx.scene).then(|| rough::boundary_of(cx.scene, v.medium)).flatten() {
+    if let Some(rb) = rough::boundary_of(cx.scene, v.medium) {
         return rough::sample(cx, opts, x_i, v, rb);
     }
     let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
     let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
     let (beta, depth, max_depth) = (v.beta, v.depth, v.max_depth);
-    if !enabled(scene) {
-        return None;
-    }
     let Some(boundary) = boundary_of(scene, x_j.medium) else { return curved::sample(cx, opts, x_i, v) };
     let u: Vec2 = sampler.next_2d();
     // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).
