@@ -161,6 +161,8 @@ RUN_COUNTS = (1, 2, 4, 8, 16)  # relMSE of the average of the first k runs (JSON
 CLASS_SUM_TOL = 1e-5  # the classes' sum against the image: max |difference| / max |image| (float32 EXR)
 LUM = np.array([0.212671, 0.715160, 0.072169])
 MI_NOT_INSTALLED = 3
+MI_V_NOTE = "Mitsuba's from rgb_moment AOVs of the same samples as a plain, timed render"
+MI_RUN = "mitsuba.momentrun"  # cache tag of Mitsuba's runs (NAME.mitsuba.momentrunI.npy/.json)
 RENDERED = [0]  # renders this process ran (a re-analysis of cached renders keeps the first run's times)
 # snee's integrator variants: name -> (integrator type, extra XML properties)
 VARIANTS = {
@@ -246,7 +248,15 @@ def snee_render(args, work, xml, tag, seed, spp=None, seconds=None, extra=()):
 def mitsuba_worker(scene, threads, variant):
     """Runs in a subprocess: load SCENE once, then answer JSON commands read line by line on stdin
     with one line "@@{json}" on stdout each: {"cmd": "probe", "seconds": S}, {"cmd": "render",
-    "spp": N, "seed": S, "out": NPY or null}, {"cmd": "firefly", "scale": K, "seed": S, "out": NPY}."""
+    "spp": N, "seed": S, "out": NPY or null, "moment": bool}, {"cmd": "run", "spp": N, "seed": S,
+    "out": NPY}, {"cmd": "firefly", "scale": K, "seed": S, "out": NPY}.
+
+    "run" is one of the study's runs: a plain render (the scene's volpath; timed: its seconds are
+    the run's t) and a render of the same samples (same seed and spp) with `rgb_moment` nesting
+    that volpath (common.register_rgb_moment: the RGB value and its square per sample as AOVs);
+    NPY gets the latter's per-pixel means and mean squares, (H, W, 6) = R, G, B, m2.R, m2.G, m2.B.
+    Its reply also has the moment render's seconds and the largest difference between the two
+    images relative to the image's maximum (the same samples: float rounding)."""
     def reply(obj):
         sys.stdout.write("@@" + json.dumps(obj) + "\n")
         sys.stdout.flush()
@@ -265,16 +275,19 @@ def mitsuba_worker(scene, threads, variant):
     dr.set_thread_count(threads)
     width, height = sc.sensors()[0].film().crop_size()
     scaled = {}
+    common.register_rgb_moment(mi)
+    moment = mi.load_dict({"type": "rgb_moment", "nested": sc.integrator()})
 
-    def run(scene_obj, spp, seed):
+    def run(scene_obj, spp, seed, integrator=None):
+        """(image channels, timing): all channels (with `moment`: R, G, B, mean.R/G/B, m2.R/G/B)."""
         if llvm:
             dr.kernel_history()  # clears the history
         c0, t0 = time.process_time(), time.perf_counter()
-        img = np.array(mi.render(scene_obj, seed=seed, spp=spp), dtype=np.float32)
+        img = np.array(mi.render(scene_obj, integrator=integrator, seed=seed, spp=spp), dtype=np.float32)
         wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         compile_s = sum(h.get("backend_time", 0.0) for h in dr.kernel_history()) / 1000.0 if llvm else 0.0
-        return img[..., :3], {"spp": spp, "seed": seed, "seconds": wall - compile_s, "wall_seconds": wall,
-                              "cpu_seconds": cpu, "compile_seconds": compile_s}
+        return img, {"spp": spp, "seed": seed, "seconds": wall - compile_s, "wall_seconds": wall,
+                     "cpu_seconds": cpu, "compile_seconds": compile_s}
 
     reply({"ready": True, "variant": variant, "notes": notes, "load_seconds": load_seconds,
            "mitsuba_version": mi.__version__, "thread_count": dr.thread_count(), "size": [width, height]})
@@ -292,16 +305,24 @@ def mitsuba_worker(scene, threads, variant):
                 spp *= 2
             reply({"rate": spp / max(t["seconds"], 1e-9), "probe": t})
         elif cmd["cmd"] == "render":
-            img, t = run(sc, cmd["spp"], cmd["seed"])
+            img, t = run(sc, cmd["spp"], cmd["seed"], moment if cmd.get("moment") else None)
             if cmd.get("out"):
-                np.save(cmd["out"], img)
+                np.save(cmd["out"], img[..., :3])
+            reply(t)
+        elif cmd["cmd"] == "run":
+            plain, t = run(sc, cmd["spp"], cmd["seed"])
+            img, tm = run(sc, cmd["spp"], cmd["seed"], moment)
+            np.save(cmd["out"], img[..., 3:9])  # mean.R/G/B, m2.R/G/B
+            t.update(moment_seconds=tm["seconds"], moment_compile_seconds=tm["compile_seconds"],
+                     plain_vs_moment=float(np.max(np.abs(plain[..., :3] - img[..., 3:6])) /
+                                           max(float(np.max(np.abs(plain[..., :3]))), 1e-30)))
             reply(t)
         elif cmd["cmd"] == "firefly":
             k = cmd["scale"]
             if k not in scaled:
                 scaled[k] = mi.load_file(scene, integrator="volpath", width=width * k, height=height * k)
             img, t = run(scaled[k], 1, cmd["seed"])
-            np.save(cmd["out"], img)
+            np.save(cmd["out"], img[..., :3])
             reply(t)
     return 0
 
@@ -349,11 +370,17 @@ class Mitsuba:
 
 # ----------------------------------------------------------------------------- statistics
 
+def sample_var(x, m2, n):
+    """Per-pixel, per-channel unbiased per-sample variance from the per-pixel means x and mean
+    squares m2 of n samples (box filter: each pixel's own samples)."""
+    return np.maximum(m2 - x * x, 0.0) * n / max(n - 1, 1)
+
+
 def moment_var(ch, n, prefix=""):
-    """Per-pixel, per-channel unbiased per-sample variance from a --moment render of n spp."""
+    """sample_var of a snee --moment render of n spp (channels R/G/B and m2.R/G/B, or a class's)."""
     x = rgb_of(ch, prefix)
     m2 = rgb_of(ch, prefix + "m2.") if prefix == "" else rgb_of(ch, prefix[:-1] + ".m2.")
-    return np.maximum(m2 - x * x, 0.0) * n / max(n - 1, 1)
+    return sample_var(x, m2, n)
 
 
 def mean_se_bound(mean, var_sample, n):
@@ -582,18 +609,19 @@ def run_config(args, P, work, name):
         rdir = os.path.join(work, "renders")
         setup_json = os.path.join(rdir, f"{name}.mitsuba.setup.json")
         cached = not args.force_renders and os.path.exists(os.path.join(rdir, f"{name}.mitsuba.firefly.npy")) and all(
-            os.path.exists(os.path.join(rdir, f"{name}.mitsuba.run{i}.{x}")) for i in range(P["runs"]) for x in ("json", "npy"))
+            os.path.exists(os.path.join(rdir, f"{name}.{MI_RUN}{i}.{x}")) for i in range(P["runs"]) for x in ("json", "npy"))
         if cached:  # the runs exist: no worker, no probe
             if os.path.exists(setup_json):
                 with open(setup_json) as fh:
                     mstat = json.load(fh)
-            with open(os.path.join(rdir, f"{name}.mitsuba.run0.json")) as fh:
+            with open(os.path.join(rdir, f"{name}.{MI_RUN}0.json")) as fh:
                 spp["mitsuba"] = json.load(fh)["spp"]
         else:
             pr = mit.call({"cmd": "probe", "seconds": P["run_time"]})
             if pr is not None:
                 spp["mitsuba"] = max(2, int(round(pr["rate"] * P["run_time"])))
-                mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 3, "out": None})  # warm-up: compiles
+                for moment in (False, True):  # warm-ups: compile the plain and the moment kernel
+                    mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 3, "out": None, "moment": moment})
                 # The probe's small renders carry a fixed cost per call, so its rate is low: one timed
                 # render at that spp corrects n so that a run takes about run_time, like snee's.
                 t = mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 4, "out": None})
@@ -624,19 +652,21 @@ def run_config(args, P, work, name):
             ch, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.run{i}",
                                  seed=seeds[m] + i, spp=spp[m], extra=["--moment"])
             runs[m].append({"x": rgb_of(ch), "var": moment_var(ch, st["spp"]), "n": st["spp"], "t": st["seconds"]})
-        if "mitsuba" in spp:
-            npy = os.path.join(work, "renders", f"{name}.mitsuba.run{i}.npy")
+        if "mitsuba" in spp:  # a plain render (timed) and the same samples with rgb_moment (mitsuba_worker)
+            npy = os.path.join(work, "renders", f"{name}.{MI_RUN}{i}.npy")
             tj = npy[:-4] + ".json"
             if args.force_renders or not (os.path.exists(npy) and os.path.exists(tj)):
                 RENDERED[0] += 1
-                t = mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 1000 + i, "out": npy})
+                t = mit.call({"cmd": "run", "spp": spp["mitsuba"], "seed": 1000 + i, "out": npy})
                 if t is None:
                     break
                 common.write_json_atomic(tj, t)
             with open(tj) as fh:
                 t = json.load(fh)
-            runs["mitsuba"].append({"x": np.load(npy).astype(np.float64), "n": t["spp"], "t": t["seconds"],
-                                    "cpu": t["cpu_seconds"]})
+            mom = np.load(npy).astype(np.float64)
+            runs["mitsuba"].append({"x": mom[..., :3], "var": sample_var(mom[..., :3], mom[..., 3:], t["spp"]),
+                                    "n": t["spp"], "t": t["seconds"], "t_moment": t["moment_seconds"],
+                                    "plain_vs_moment": t["plain_vs_moment"], "cpu": t["cpu_seconds"]})
     if "mitsuba" in spp and len(runs["mitsuba"]) < P["runs"]:
         runs["mitsuba"] = []
     res["mitsuba_status"] = "not run (--no-mitsuba)" if mit is None else mit.status
@@ -698,27 +728,26 @@ def run_config(args, P, work, name):
             return n * float(w @ np.diag(gram) - w @ gram @ w) * (k / (k - 1)) ** (2 if resampled else 1)
         s = {"spp": n, "t": t.tolist(), "c": float(t.sum() / (N * n)), "run_means": run_means.tolist(),
              "V_spread": n * float(spread.mean())}
-        if m != "mitsuba":
-            vm = np.array([float(np.mean(r["var"] / denom)) for r in rs])
-            s["V_runs"] = vm.tolist()
-            s["V"] = float(vm.mean())
-        else:
-            s["V"] = s["V_spread"]
+        vm = np.array([float(np.mean(r["var"] / denom)) for r in rs])  # per run, from its per-pixel moments
+        s["V_runs"] = vm.tolist()
+        s["V"] = float(vm.mean())
+        s["V_from"] = "per-pixel moments" + (" (rgb_moment; t from a plain render of the same samples)"
+                                              if m == "mitsuba" else " (--moment)")
+        if m == "mitsuba":
+            tm = np.array([r["t_moment"] for r in rs])
             s["cpu_per_second"] = float(sum(r["cpu"] for r in rs) / t.sum())
+            s["t_moment"] = tm.tolist()  # the rgb_moment renders' times (not used for c)
+            s["moment_time_over_plain_median"] = float(np.median(tm / t))
+            s["plain_vs_moment_max_rel_diff"] = float(max(r["plain_vs_moment"] for r in rs))
         s["efficiency"] = safe_div(1.0, s["V"] * s["c"])
         a = X.mean(axis=0)
         avg[m] = a
         mu = float(run_means.mean())
-        if m != "mitsuba":  # standard error of the mean of all N n samples per pixel (moments)
-            _, se = mean_se_bound(a, np.mean([r["var"] for r in rs], axis=0), N * n)
-            z = zscore(mu, se, ref["mean"], ref["se"])
-        else:  # only the N runs' means: a t statistic with N - 1 degrees of freedom, as the equivalent z
-            from scipy.stats import norm
-            from scipy.stats import t as student_t
-            se = float(run_means.std(ddof=1) / math.sqrt(N))
-            tstat = zscore(mu, se, ref["mean"], ref["se"])
-            s["t_stat"] = tstat
-            z = math.copysign(float(norm.isf(student_t.sf(abs(tstat), N - 1))), tstat) if math.isfinite(tstat) else tstat
+        # standard error of the mean of all N n samples per pixel (moments)
+        _, se = mean_se_bound(a, np.mean([r["var"] for r in rs], axis=0), N * n)
+        z = zscore(mu, se, ref["mean"], ref["se"])
+        if m == "mitsuba":  # cross-check from the N runs' means only: a t statistic, N - 1 degrees of freedom
+            s["t_stat_spread"] = zscore(mu, float(run_means.std(ddof=1) / math.sqrt(N)), ref["mean"], ref["se"])
         # relMSE at the reference's resolution (the runs' averages downsampled: with the box filter
         # that is the image the reference estimates).
         s.update(mean=mu, se=se, z=z,
@@ -733,7 +762,7 @@ def run_config(args, P, work, name):
 
     def eff(m, idx, resampled=True):
         s = stats[m]
-        v = s["_vspread"](idx, resampled) if m == "mitsuba" else float(np.mean(np.array(s["V_runs"])[idx]))
+        v = float(np.mean(np.array(s["V_runs"])[idx]))
         return safe_div(1.0, v * float(np.sum(np.array(s["t"])[idx]) / (len(idx) * s["spp"])))
 
     # Seed stability: the same ratio and interval from each half of the runs (seeds +0..N/2-1 and
@@ -755,9 +784,12 @@ def run_config(args, P, work, name):
                                               "lo": hlo, "hi": hhi})
     for m in stats:
         v = stats[m]
-        v["V_ci"] = list(common.bootstrap_ci(lambda idx, m=m: (stats[m]["_vspread"](idx) if m == "mitsuba" else
-                                                             float(np.mean(np.array(stats[m]["V_runs"])[idx]))),
-                                             N, b=P["boot"]))
+        v_runs = np.array(v["V_runs"])
+        v["V_ci"] = list(common.bootstrap_ci(lambda idx, v_runs=v_runs: float(np.mean(v_runs[idx])), N, b=P["boot"]))
+        # The two estimates of V from the same runs (moments; spread of the runs' images): their ratio
+        # with a bootstrap interval over runs, a check of the moment estimate.
+        v["V_over_V_spread"] = [safe_div(v["V"], v["V_spread"]), *common.bootstrap_ci(
+            lambda idx, v_runs=v_runs, f=v["_vspread"]: safe_div(float(np.mean(v_runs[idx])), f(idx)), N, b=P["boot"])]
         del v["_X"], v["_vspread"]
     res["methods"] = stats
     res["ratios"] = ratios
@@ -793,7 +825,8 @@ def run_config(args, P, work, name):
 # one-configuration runs, see figures/README.md): per snee render, process start and scene loading;
 # Mitsuba: worker start, scene load, probe and kernel compilation, and the firefly render's reload.
 SNEE_START = 0.25
-MITSUBA_SETUP = 20.0
+MITSUBA_SETUP = 25.0
+MITSUBA_PER_RUN = 2.05  # a plain render of run_time and the rgb_moment render of the same samples
 FIXED_PER_CONFIG = 8.0  # complete check, firefly renders, Figure 3 renders
 REPORT = 30.0  # the report's statistics and figures, once
 
@@ -804,7 +837,7 @@ def estimate_seconds(P, names, complete_configs):
     total = REPORT
     for name in names:
         m_snee = 3 if name in complete_configs else 2
-        per_run = m_snee * (P["run_time"] + SNEE_START) + P["run_time"]
+        per_run = m_snee * (P["run_time"] + SNEE_START) + MITSUBA_PER_RUN * P["run_time"]
         total += (P["runs"] * per_run + m_snee * (P["probe"] * P["run_time"] + SNEE_START)
                   + m_snee * (1.3 * P["run_time"] + SNEE_START) + MITSUBA_SETUP + 2 * P["run_time"] + FIXED_PER_CONFIG)
     return total
@@ -970,6 +1003,8 @@ def report(args, P, mode, work, names, results, total, load):
     zcrit = common.sidak_z(ALPHA, n_tests)
     mi_variants = sorted({r["mitsuba"].get("variant") for r in results.values() if r.get("mitsuba")} - {None})
     mi_note = ("Mitsuba volpath " + "/".join(mi_variants)) if mi_variants else "Mitsuba not run"
+    mi_v = sorted({r["methods"]["mitsuba"].get("V_from", "the spread of the runs' images")
+                   for r in results.values() if "mitsuba" in r["methods"]})
 
     def ratio_cell(r, other):
         q = r["ratios"].get(other)
@@ -1033,7 +1068,8 @@ def report(args, P, mode, work, names, results, total, load):
                f"≥ {P['ref_factor']} x the spp of a volpath run (rendered ahead, {ref_wall / 60:.1f} min of top-up "
                f"in this run); rendering wall time {render_wall / 60:.1f} min (estimated "
                f"{'-'.join(f'{e / 60:.1f}' for e in getattr(args, 'estimate', [])) or 'n/a'} min) at a load average of "
-               f"{min(loads, default=0):.1f}-{max(loads, default=0):.1f}; {mi_note}.")
+               f"{min(loads, default=0):.1f}-{max(loads, default=0):.1f}; {mi_note}"
+               + (f", its V from {' / '.join(mi_v)}" if mi_v else "") + ".")
     verdicts = []
     for other, label in (("volpath", "snee volpath"), ("mitsuba", "Mitsuba volpath")):
         black = [n for n in names if results[n]["methods"].get(other, {}).get("mean") == 0.0]
@@ -1054,6 +1090,14 @@ def report(args, P, mode, work, names, results, total, load):
                         f"{fmt(float(np.median(spans)) if spans else None)}; the two halves of the runs' seeds give "
                         f"overlapping intervals in {overlap} of {len(hv)}")
     summary += " " + "; ".join(verdicts) + "."
+    vv = [(n, m, s["V_over_V_spread"]) for n in names for m, s in results[n]["methods"].items()
+          if s.get("V_over_V_spread") and None not in s["V_over_V_spread"]]
+    if vv:
+        q = {m: sorted(x[0] for _, mm, x in vv if mm == m) for m in dict.fromkeys(mm for _, mm, _ in vv)}
+        summary += (" V from the moments over V from the spread of the runs' images (a check; 95 % bootstrap interval "
+                    f"containing 1 in {sum(1 for _, _, x in vv if x[1] <= 1 <= x[2])} of {len(vv)}): " +
+                    ", ".join(f"{dict((k, l) for k, l, _ in METHODS).get(m, m)} {x[0]:.2f}-{x[-1]:.2f}"
+                              for m, x in q.items()) + ".")
     cls_names = sorted({k for n in names for c in results[n].get("classes", {}).values() for k in c["share"]},
                        key=lambda k: (CLASS_ORDER.index(k) if k in CLASS_ORDER else len(CLASS_ORDER), k))
     cls_lines, diffs = [], []
@@ -1126,7 +1170,8 @@ def parser():
     size.add_argument("--paper", action="store_true", help="the paper's size, as Ray tasks")
     size.add_argument("--smoke", action="store_true", help="tiny sizes: checks the pipeline, numbers mean nothing")
     ap.add_argument("--threads", type=int, default=None, help="render threads per method (default: the mode's)")
-    ap.add_argument("--only", default="*", help="glob over configuration names, e.g. 'directional_*'")
+    ap.add_argument("--only", default="*", help="globs over configuration names, comma-separated, e.g. "
+                    "'directional_*' or 'sphere_ggx0*_st34,envmap_ggx020_st02'")
     ap.add_argument("--out", default=None, help="outputs (default figures/ or figures/paper_size/)")
     ap.add_argument("--work", default=None, help="render cache (default target/study/<mode>)")
     ap.add_argument("--refs", default=None, help="reference cache (default WORK/refs); may be rendered ahead "
@@ -1175,11 +1220,12 @@ def main():
         return mitsuba_worker(scene, int(threads), variant)
     if not os.path.exists(args.snee):
         sys.exit(f"{args.snee} not found: run `cargo build --release` first")
-    names = [n for n in configs() if fnmatch.fnmatch(n, args.only)]
+    names = [n for n in configs() if any(fnmatch.fnmatch(n, g) for g in args.only.split(","))]
     t0, load0 = time.time(), os.getloadavg()[0]
     print(f"mode {args.mode}: {len(names)} configurations, {P['runs']} runs x {P['run_time']:g} s, reference "
           f"{P['ref_factor']} x, --threads {args.threads}, transport classes: "
-          f"{'yes' if args.classes else 'not in this binary'}; load average {load0:.2f}", flush=True)
+          f"{'yes' if args.classes else 'not in this binary'}; V of every method, Mitsuba's too, from per-pixel "
+          f"moments ({MI_V_NOTE}); load average {load0:.2f}", flush=True)
     smooth = [n for n in names if "_smooth_" in n]
     est0, est1 = estimate_seconds(P, names, []), estimate_seconds(P, names, smooth)
     est_ref = missing_reference_seconds(P, args.refs, names)
