@@ -68,7 +68,9 @@ MAX_SAMPLES_PER_PASS = 1 << 22
 def register_rgb_moment(mi):
     """Register `rgb_moment`: Mitsuba's `moment` integrator in RGB. It calls the nested integrator's
     sample() once and returns its RGB value and the squares (with `cross`, also the cross products)
-    as AOVs mean.R/G/B, m2.R/G/B (+ m2.RG/GB/RB)."""
+    as AOVs mean.R/G/B, m2.R/G/B (+ m2.RG/GB/RB); the image channels are the nested integrator's,
+    from the same samples. (Mitsuba's own `moment` stores X, Y, Z and their squares: without the
+    cross moments they do not give the per-channel RGB variances.)"""
 
     class RGBMomentIntegrator(mi.SamplingIntegrator):
         def __init__(self, props):

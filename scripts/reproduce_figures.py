@@ -47,23 +47,34 @@ Runs (interleaved: volpath, volpath_snee, [complete,] Mitsuba, volpath, ... so a
   each method first renders one probe of probe x RUN_TIME seconds (not used) to measure its rate,
   then RUNS (16) independent runs with distinct seeds at the FIXED spp n = rate * RUN_TIME. snee:
   --moment, time t from --stats (scene loading excluded). Mitsuba: a persistent worker process (this
-  script with --mitsuba-worker) that loaded the unchanged XML once (default integrator volpath); t
-  is the wall clock around mi.render minus drjit's LLVM compile time; one untimed warm-up at n
-  compiles the kernel first. Variant llvm_ad_rgb (else scalar_rgb), dr.set_thread_count(THREADS).
+  script with --mitsuba-worker) that loaded the unchanged XML once (default integrator volpath); a
+  run is two renders of the same samples (same seed and n): the scene's volpath, timed (t is the
+  wall clock around mi.render minus drjit's LLVM compile time), and `rgb_moment`
+  (common.register_rgb_moment) nesting that same volpath, which returns each sample's RGB and its
+  square as AOVs, so the box-filtered film holds per-pixel sample means and mean squares exactly as
+  snee's --moment. Why two renders: the moment render costs extra (6 more film channels per
+  sample; JSON moment_time_over_plain_median, 1.03 measured on sphere_ggx020_st34), so it is not
+  timed; JSON plain_vs_moment_max_rel_diff shows both are the same samples (float rounding).
+  Mitsuba's own `moment` integrator is not used: it writes X, Y, Z and their squares, and the
+  per-channel RGB variances need cross moments it does not write (R is a combination of X, Y, Z).
+  One untimed warm-up of each kernel at n compiles them first. Variant llvm_ad_rgb (else
+  scalar_rgb), dr.set_thread_count(THREADS).
 
 Efficiency (per method): V = per-sample relative variance = mean over pixels and channels of
 sigma^2_p / (d_p^2 + eps); c = seconds per sample per pixel = sum t / (RUNS n); a render of time t has
 relative variance RV(t) = V c / t, so efficiency = 1 / (RV t) = 1 / (V c).
-  * snee methods, V from moments: per run, sigma^2_p = (m2_p - x_p^2) n / (n - 1) (m2 is the
-    per-pixel mean of the squared samples, src/render.rs; unbiased per run); V = mean over runs.
-  * Mitsuba (no per-pixel moments in RGB), V from the spread of the runs: with s^2_p the sample
-    variance (ddof 1) of pixel p over the RUNS runs, E[s^2_p] = sigma^2_p / n, so
-    V = n * mean(s^2_p / (d^2 + eps)): the same quantity. snee's methods get this estimate too
-    (JSON: V_spread), a check of the moment estimate.
+  * V from per-pixel moments, the same way for every method (snee's and Mitsuba's): per run,
+    sigma^2_p = (m2_p - x_p^2) n / (n - 1) (m2 is the per-pixel mean of the squared samples;
+    unbiased per run); V_run = mean over pixels and channels of sigma^2_p / (d_p^2 + eps); V = mean
+    over runs.
+  * A check (JSON V_spread, V_over_V_spread = [V / V_spread, 95 % bootstrap interval]): V from the
+    spread of the runs: with s^2_p the sample variance (ddof 1) of pixel p over the RUNS runs,
+    E[s^2_p] = sigma^2_p / n, so V_spread = n * mean(s^2_p / (d^2 + eps)) estimates the same
+    quantity from the same samples (before Mitsuba's runs had moments, its V).
   * Ratios volpath_snee / volpath, volpath_snee / Mitsuba volpath (and complete / volpath_snee),
     with a 95 % percentile bootstrap over runs (run indices resampled jointly for all methods:
-    interleaved runs share the load); a resampled spread estimate is multiplied by RUNS / (RUNS - 1)
-    (the bootstrap's bias of a ddof-1 variance). An undecided ratio whose interval lies within
+    interleaved runs share the load); in the V_spread check's bootstrap a resampled spread estimate
+    is multiplied by RUNS / (RUNS - 1) (the bootstrap's bias of a ddof-1 variance). An undecided ratio whose interval lies within
     [1/1.1, 1.1] is counted as "equal within +-10 %". Seed stability: every ratio is also computed
     from each half of the runs (seeds +0..7 and +8..15, JSON `halves`, with their own bootstrap
     intervals); the summary counts the configurations whose two halves' intervals overlap.
@@ -74,8 +85,9 @@ relative variance RV(t) = V c / t, so efficiency = 1 / (RV t) = 1 / (V c).
   * A ratio where the compared method fails the bias test measures the variance of an estimate of
     a different integral (volpath under directional + smooth is black): flagged in the table.
 Bias: image mean (pixels and channels) of the RUNS-run average against the reference; standard
-  error from the moments (snee) or the spread of the runs' means (Mitsuba, as a t statistic), plus
-  the reference's; |z| judged at the Sidak threshold for family-wise 1 % over all tests.
+  error from the moments (every method; for Mitsuba also, as a check, a t statistic from the spread
+  of the runs' means: JSON t_stat_spread), plus the reference's; |z| judged at the Sidak threshold
+  for family-wise 1 % over all tests.
 Firefly rate: each method renders the scene once at FIREFLY_SCALE times the width and height with
   1 spp (box filter: each pixel is one sample, distributed over the film as the samples of the
   normal render); rate = samples per 10^6 whose luminance exceeds 100 x the reference image's mean
@@ -731,6 +743,7 @@ def run_config(args, P, work, name):
         vm = np.array([float(np.mean(r["var"] / denom)) for r in rs])  # per run, from its per-pixel moments
         s["V_runs"] = vm.tolist()
         s["V"] = float(vm.mean())
+        s["V_halves"] = [float(vm[:N // 2].mean()), float(vm[N // 2:2 * (N // 2)].mean())] if N >= 4 else []
         s["V_from"] = "per-pixel moments" + (" (rgb_moment; t from a plain render of the same samples)"
                                               if m == "mitsuba" else " (--moment)")
         if m == "mitsuba":
@@ -1080,15 +1093,27 @@ def report(args, P, mode, work, names, results, total, load):
         undecided = [x for x in q if x["lo"] <= 1 <= x["hi"]]
         equal = sum(1 for x in undecided if x["lo"] >= 1 / (1 + EQUAL_WITHIN) and x["hi"] <= 1 + EQUAL_WITHIN)
         spans = [math.sqrt(x["hi"] / x["lo"]) for x in q if x["lo"] > 0]
-        hv = [x["halves"] for x in q if len(x.get("halves", [])) == 2 and
+        qn = [(n, results[n]["ratios"].get(other)) for n in names if n not in black]
+        hv = [(n, x["halves"]) for n, x in qn if x and len(x.get("halves", [])) == 2 and
               all(h.get("lo") is not None and h.get("hi") is not None for h in x["halves"])]
-        overlap = sum(1 for a, b in hv if a["lo"] <= b["hi"] and b["lo"] <= a["hi"])
+        apart = [n for n, (a, b) in hv if not (a["lo"] <= b["hi"] and b["lo"] <= a["hi"])]
+        overlap = len(hv) - len(apart)
+
+        def halves_note(n, other=other):
+            """The method of the pair whose V differs most between the halves (JSON V_halves)."""
+            f = {m: max(h) / min(h) for m in ("snee", other) for h in [results[n]["methods"][m].get("V_halves")]
+                 if h and min(h) > 0}
+            if not f:
+                return n
+            m = max(f, key=f.get)
+            return f"{n}: V of {dict((k, l) for k, l, _ in METHODS)[m]} differs ×{f[m]:.1f} between them"
         verdicts.append(f"volpath_snee vs {label}: more efficient (95 % interval above 1) in {win}, less efficient "
                         f"(below 1) in {lose}, undecided in {len(undecided)} (of them equal within "
                         f"±{100 * EQUAL_WITHIN:.0f} %: {equal}) of {len(q)} configurations where both render the "
                         f"transport (in {len(black)} more, {label} renders black); median interval ×/÷ "
                         f"{fmt(float(np.median(spans)) if spans else None)}; the two halves of the runs' seeds give "
-                        f"overlapping intervals in {overlap} of {len(hv)}")
+                        f"overlapping intervals in {overlap} of {len(hv)}" +
+                        (f" (not in {'; '.join(halves_note(n) for n in apart)})" if apart else ""))
     summary += " " + "; ".join(verdicts) + "."
     vv = [(n, m, s["V_over_V_spread"]) for n in names for m, s in results[n]["methods"].items()
           if s.get("V_over_V_spread") and None not in s["V_over_V_spread"]]
