@@ -77,7 +77,10 @@ relative variance RV(t) = V c / t, so efficiency = 1 / (RV t) = 1 / (V c).
     is multiplied by RUNS / (RUNS - 1) (the bootstrap's bias of a ddof-1 variance). An undecided ratio whose interval lies within
     [1/1.1, 1.1] is counted as "equal within +-10 %". Seed stability: every ratio is also computed
     from each half of the runs (seeds +0..7 and +8..15, JSON `halves`, with their own bootstrap
-    intervals); the summary counts the configurations whose two halves' intervals overlap.
+    intervals); the summary counts the configurations whose two halves' intervals overlap and, where
+    they do not, names the method whose V differs most between the halves (JSON V_halves). JSON
+    V_top_pixel_share: per run, the largest single pixel's share of V_run, averaged over the runs
+    (near 1: V rests on a few rare, bright samples, and 8 runs may or may not contain one).
   * Why 16 runs x 1 s (figures/README.md, "Choosing the standard size"): V is a mean of squared,
     heavy-tailed samples; its relative error falls as 1/sqrt(samples per method), and the width of
     the intervals is set by the samples, not by the number of pixels, so the standard size buys
@@ -740,10 +743,14 @@ def run_config(args, P, work, name):
             return n * float(w @ np.diag(gram) - w @ gram @ w) * (k / (k - 1)) ** (2 if resampled else 1)
         s = {"spp": n, "t": t.tolist(), "c": float(t.sum() / (N * n)), "run_means": run_means.tolist(),
              "V_spread": n * float(spread.mean())}
-        vm = np.array([float(np.mean(r["var"] / denom)) for r in rs])  # per run, from its per-pixel moments
+        vpix = [np.mean(r["var"] / denom, axis=-1) for r in rs]  # per run and pixel, from its per-pixel moments
+        vm = np.array([float(v.mean()) for v in vpix])
+        # How few samples carry V: per run, the largest single pixel's share of V_run (mean over runs).
+        s_top = float(np.mean([safe_div(float(v.max()), float(v.sum())) for v in vpix if v.sum() > 0] or [math.nan]))
         s["V_runs"] = vm.tolist()
         s["V"] = float(vm.mean())
         s["V_halves"] = [float(vm[:N // 2].mean()), float(vm[N // 2:2 * (N // 2)].mean())] if N >= 4 else []
+        s["V_top_pixel_share"] = s_top
         s["V_from"] = "per-pixel moments" + (" (rgb_moment; t from a plain render of the same samples)"
                                               if m == "mitsuba" else " (--moment)")
         if m == "mitsuba":
