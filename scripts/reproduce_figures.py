@@ -52,9 +52,10 @@ Runs (interleaved: volpath, volpath_snee, [complete,] Mitsuba, volpath, ... so a
   wall clock around mi.render minus drjit's LLVM compile time), and `rgb_moment`
   (common.register_rgb_moment) nesting that same volpath, which returns each sample's RGB and its
   square as AOVs, so the box-filtered film holds per-pixel sample means and mean squares exactly as
-  snee's --moment. Why two renders: the moment render costs extra (6 more film channels per
-  sample; JSON moment_time_over_plain_median, 1.03 measured on sphere_ggx020_st34), so it is not
-  timed; JSON plain_vs_moment_max_rel_diff shows both are the same samples (float rounding).
+  snee's --moment. Why two renders: the moment render writes 6 more film channels per sample, an
+  overhead not shown to be below 2 % (JSON moment_time_over_plain_median: 0.97-1.06 per
+  configuration at load 7-10, i.e. lost in the noise there), so it is not timed; JSON
+  plain_vs_moment_max_rel_diff shows both are the same samples (<= 3e-7: float rounding).
   Mitsuba's own `moment` integrator is not used: it writes X, Y, Z and their squares, and the
   per-channel RGB variances need cross moments it does not write (R is a combination of X, Y, Z).
   One untimed warm-up of each kernel at n compiles them first. Variant llvm_ad_rgb (else
