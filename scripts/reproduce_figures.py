@@ -844,9 +844,11 @@ def run_config(args, P, work, name):
 
 # A-priori time model of one configuration on an idle machine (seconds; calibrated on the smoke and
 # one-configuration runs, see figures/README.md): per snee render, process start and scene loading;
-# Mitsuba: worker start, scene load, probe and kernel compilation, and the firefly render's reload.
+# Mitsuba: worker start, scene load, probe and the compilation of the plain and the moment kernel (the
+# quiet 16 x 1 s run spent 4-7 s in all set-up with drjit's kernel cache warm; a cold moment kernel
+# compiles in about 4 s), and the firefly render's reload.
 SNEE_START = 0.25
-MITSUBA_SETUP = 25.0
+MITSUBA_SETUP = 10.0
 MITSUBA_PER_RUN = 2.05  # a plain render of run_time and the rgb_moment render of the same samples
 FIXED_PER_CONFIG = 8.0  # complete check, firefly renders, Figure 3 renders
 REPORT = 30.0  # the report's statistics and figures, once
