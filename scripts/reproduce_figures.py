@@ -75,8 +75,8 @@ relative variance RV(t) = V c / t, so efficiency = 1 / (RV t) = 1 / (V c).
   * Ratios volpath_snee / volpath, volpath_snee / Mitsuba volpath (and complete / volpath_snee),
     with a 95 % percentile bootstrap over runs (run indices resampled jointly for all methods:
     interleaved runs share the load); in the V_spread check's bootstrap a resampled spread estimate
-    is multiplied by RUNS / (RUNS - 1) (the bootstrap's bias of a ddof-1 variance). An undecided ratio whose interval lies within
-    [1/1.1, 1.1] is counted as "equal within +-10 %". Seed stability: every ratio is also computed
+    is multiplied by RUNS / (RUNS - 1) (the bootstrap's bias of a ddof-1 variance). An undecided
+    ratio whose interval lies within [1/1.1, 1.1] is counted as "equal within +-10 %". Seed stability: every ratio is also computed
     from each half of the runs (seeds +0..7 and +8..15, JSON `halves`, with their own bootstrap
     intervals); the summary counts the configurations whose two halves' intervals overlap and, where
     they do not, names the method whose V differs most between the halves (JSON V_halves). JSON
@@ -625,7 +625,8 @@ def run_config(args, P, work, name):
         rdir = os.path.join(work, "renders")
         setup_json = os.path.join(rdir, f"{name}.mitsuba.setup.json")
         cached = not args.force_renders and os.path.exists(os.path.join(rdir, f"{name}.mitsuba.firefly.npy")) and all(
-            os.path.exists(os.path.join(rdir, f"{name}.{MI_RUN}{i}.{x}")) for i in range(P["runs"]) for x in ("json", "npy"))
+            os.path.exists(os.path.join(rdir, f"{name}.{MI_RUN}{i}.{x}"))
+            for i in range(P["runs"]) for x in ("json", "npy"))
         if cached:  # the runs exist: no worker, no probe
             if os.path.exists(setup_json):
                 with open(setup_json) as fh:
