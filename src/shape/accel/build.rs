@@ -237,9 +237,8 @@ fn best_split(bins: &Bins, binning: &Binning) -> Option<(usize, usize)> {
         e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
     };
     // Cost of a side: its area times its count; NaN (never below the best) for an empty side.
-    let cost = |lo: &[Vec4; 3], hi: &[Vec4; 3], n: Vec4| {
-        Vec4::select(n.cmpgt(Vec4::ZERO), half_area(lo, hi) * n, Vec4::NAN)
-    };
+    let cost =
+        |lo: &[Vec4; 3], hi: &[Vec4; 3], n: Vec4| Vec4::select(n.cmpgt(Vec4::ZERO), half_area(lo, hi) * n, Vec4::NAN);
     // Bin i transposed (written by the right-to-left pass, read by the left-to-right one), and
     // the cost of the right side of a split before bin i.
     let mut t = [const { MaybeUninit::<Transposed>::uninit() }; BINS];

@@ -233,11 +233,19 @@ macro_rules! any_body {
             if cur & LEAF == 0 {
                 let node = &bvh.nodes[cur as usize];
                 let mut mask = $node_test!(node, &nr, tmax, &mut t_near);
-                while mask != 0 {
-                    let slot = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    stack[sp] = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
-                    sp += 1;
+                if mask != 0 {
+                    // Descend into the hit child of the highest slot; push the others (lowest
+                    // first, so they are visited from the highest down).
+                    let last = 31 - mask.leading_zeros();
+                    mask &= !(1 << last);
+                    while mask != 0 {
+                        let slot = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack[sp] = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
+                        sp += 1;
+                    }
+                    cur = node.child[last as usize];
+                    continue;
                 }
             } else if wt.any4(&bvh.packets[(cur & !LEAF) as usize], tmax) {
                 break true;
