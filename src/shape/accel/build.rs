@@ -22,8 +22,9 @@
 use super::bvh8::{Bvh8, Node8, EMPTY, LEAF, LEAF_SIZE};
 use super::triangle::TriPacket4;
 use crate::math::Vec3;
-use glam::Vec3A;
+use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
+use std::mem::MaybeUninit;
 
 /// Bins per axis (at most; a cluster of `n` triangles uses `n` of them).
 const BINS: usize = 32;
@@ -180,36 +181,100 @@ fn merge_bins(mut a: Bins, b: Bins) -> Bins {
     a
 }
 
+/// One bin on the three axes, lane a for axis a (lane 3: an empty box without triangles).
+struct Transposed {
+    /// Min x, y, z of the bin's box.
+    lo: [Vec4; 3],
+    /// Max x, y, z.
+    hi: [Vec4; 3],
+    count: Vec4,
+}
+
+impl Transposed {
+    #[inline(always)]
+    fn of(bins: &Bins, i: usize) -> Transposed {
+        let b = [&bins[0][i], &bins[1][i], &bins[2][i]];
+        let count = Vec4::new(b[0].count as f32, b[1].count as f32, b[2].count as f32, 0.0);
+        let lo = transpose3([b[0].bounds.min, b[1].bounds.min, b[2].bounds.min], f32::INFINITY);
+        let hi = transpose3([b[0].bounds.max, b[1].bounds.max, b[2].bounds.max], f32::NEG_INFINITY);
+        Transposed { lo, hi, count }
+    }
+}
+
+/// Rows x, y, z of the 3×3 matrix with rows `v`, as vectors with `w` in lane 3.
+#[inline(always)]
+fn transpose3(v: [Vec3A; 3], w: f32) -> [Vec4; 3] {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        let [a, b, c]: [__m128; 3] = v.map(Into::into);
+        // SAFETY: SSE is part of x86-64 (the usual 4×4 transpose, fourth row all `w`).
+        unsafe {
+            let d = _mm_set1_ps(w);
+            let (ab_lo, cd_lo) = (_mm_unpacklo_ps(a, b), _mm_unpacklo_ps(c, d));
+            let (ab_hi, cd_hi) = (_mm_unpackhi_ps(a, b), _mm_unpackhi_ps(c, d));
+            [_mm_movelh_ps(ab_lo, cd_lo).into(), _mm_movehl_ps(cd_lo, ab_lo).into(), _mm_movelh_ps(ab_hi, cd_hi).into()]
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        [0, 1, 2].map(|c| Vec4::new(v[0][c], v[1][c], v[2][c], w))
+    }
+}
+
 /// The cheapest split of the binned cluster: (axis, first bin of the right side), or None when
 /// no plane separates the centroids.
+///
+/// The three axes are swept at once, one SIMD lane each (lane 3 unused): the bins are transposed
+/// once, then a right-to-left and a left-to-right pass accumulate boxes and counts. The costs are
+/// the same float operations as one axis at a time (`half_area` times the count), so the chosen
+/// split is too: the first bin of least cost, on the first axis of least cost.
 fn best_split(bins: &Bins, binning: &Binning) -> Option<(usize, usize)> {
-    let mut best: Option<(usize, usize)> = None;
-    let mut best_cost = f32::INFINITY;
     let nb = binning.count;
-    for (axis, bins) in bins.iter().enumerate() {
-        if binning.scale[axis] == 0.0 {
-            continue;
+    // Half the surface area of the boxes (0 for an empty one), as `Bounds::half_area`.
+    let half_area = |lo: &[Vec4; 3], hi: &[Vec4; 3]| {
+        let e = [0, 1, 2].map(|c| (hi[c] - lo[c]).max(Vec4::ZERO));
+        e[0] * e[1] + e[1] * e[2] + e[2] * e[0]
+    };
+    // Cost of a side: its area times its count; NaN (never below the best) for an empty side.
+    let cost =
+        |lo: &[Vec4; 3], hi: &[Vec4; 3], n: Vec4| Vec4::select(n.cmpgt(Vec4::ZERO), half_area(lo, hi) * n, Vec4::NAN);
+    // Bin i transposed (written by the right-to-left pass, read by the left-to-right one), and
+    // the cost of the right side of a split before bin i.
+    let mut t = [const { MaybeUninit::<Transposed>::uninit() }; BINS];
+    let mut right_cost = [const { MaybeUninit::<Vec4>::uninit() }; BINS];
+    let (mut acc_lo, mut acc_hi, mut n) = ([Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3], Vec4::ZERO);
+    for i in (1..nb).rev() {
+        let b = t[i].write(Transposed::of(bins, i));
+        for c in 0..3 {
+            acc_lo[c] = acc_lo[c].min(b.lo[c]);
+            acc_hi[c] = acc_hi[c].max(b.hi[c]);
         }
-        // Right-to-left sweep: cost of the right side for a split before bin i.
-        let mut right_cost = [0.0f32; BINS];
-        let mut acc = Bounds::EMPTY;
-        let mut n = 0;
-        for i in (1..nb).rev() {
-            acc.grow(&bins[i].bounds);
-            n += bins[i].count;
-            right_cost[i] = if n > 0 { acc.half_area() * n as f32 } else { f32::NAN };
+        n += b.count;
+        right_cost[i].write(cost(&acc_lo, &acc_hi, n));
+    }
+    t[0].write(Transposed::of(bins, 0));
+    let (mut acc_lo, mut acc_hi, mut n) = ([Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3], Vec4::ZERO);
+    let (mut best_cost, mut best_bin) = (Vec4::INFINITY, Vec4::ZERO);
+    for i in 1..nb {
+        // SAFETY: bins 0..nb and right costs 1..nb were written above.
+        let (b, right) = unsafe { (t[i - 1].assume_init_ref(), right_cost[i].assume_init()) };
+        for c in 0..3 {
+            acc_lo[c] = acc_lo[c].min(b.lo[c]);
+            acc_hi[c] = acc_hi[c].max(b.hi[c]);
         }
-        let mut acc = Bounds::EMPTY;
-        let mut n = 0;
-        for i in 1..nb {
-            acc.grow(&bins[i - 1].bounds);
-            n += bins[i - 1].count;
-            // NaN (an empty side) never compares below the best cost.
-            let cost = if n > 0 { acc.half_area() * n as f32 + right_cost[i] } else { f32::NAN };
-            if cost < best_cost {
-                best_cost = cost;
-                best = Some((axis, i));
-            }
+        n += b.count;
+        let total = cost(&acc_lo, &acc_hi, n) + right;
+        let better = total.cmplt(best_cost);
+        best_cost = Vec4::select(better, total, best_cost);
+        best_bin = Vec4::select(better, Vec4::splat(i as f32), best_bin);
+    }
+    let mut best: Option<(usize, usize)> = None;
+    let mut least = f32::INFINITY;
+    for axis in 0..3 {
+        if binning.scale[axis] != 0.0 && best_cost[axis] < least {
+            least = best_cost[axis];
+            best = Some((axis, best_bin[axis] as usize));
         }
     }
     // Infinite costs (overflowing areas) leave `best` empty when nothing is finite; then a split
@@ -258,21 +323,45 @@ fn split(prims: &mut [Bounds], ids: &mut [u32], c: &Cluster, bins: &mut Bins) ->
     let (mut lb, mut lc, mut rb, mut rc) = (Bounds::EMPTY, Bounds::EMPTY, Bounds::EMPTY, Bounds::EMPTY);
     let mid = match best_split(bins, &binning) {
         Some((axis, first_right)) => {
+            // Hoare's partition: each side scans past the primitives already on their side, and
+            // only a misplaced pair is swapped.
             let (mut i, mut j) = (0, p.len());
-            while i < j {
-                let b = p[i];
-                let cen = b.centroid2();
-                if binning.below(cen, axis, first_right) {
-                    lb.grow(&b);
+            'outer: loop {
+                let ci = loop {
+                    if i == j {
+                        break 'outer;
+                    }
+                    let cen = p[i].centroid2();
+                    if !binning.below(cen, axis, first_right) {
+                        break cen;
+                    }
+                    lb.grow(&p[i]);
                     lc.grow_point(cen);
                     i += 1;
-                } else {
-                    rb.grow(&b);
-                    rc.grow_point(cen);
+                };
+                // p[i] belongs right.
+                let cj = loop {
                     j -= 1;
-                    p.swap(i, j);
-                    id.swap(i, j);
-                }
+                    if j == i {
+                        rb.grow(&p[i]);
+                        rc.grow_point(ci);
+                        break 'outer;
+                    }
+                    let cen = p[j].centroid2();
+                    if binning.below(cen, axis, first_right) {
+                        break cen;
+                    }
+                    rb.grow(&p[j]);
+                    rc.grow_point(cen);
+                };
+                // p[j] belongs left: swap the pair.
+                p.swap(i, j);
+                id.swap(i, j);
+                lb.grow(&p[i]);
+                lc.grow_point(cj);
+                rb.grow(&p[j]);
+                rc.grow_point(ci);
+                i += 1;
             }
             i
         }
@@ -405,12 +494,13 @@ fn open(prims: &mut [Bounds], ids: &mut [u32], c: Cluster, bins: &mut Bins) -> (
     // Leaf-sized clusters are tried largest first; once one does not pay, no other is tried (on
     // a smooth mesh none pays, and trying all of them made the build 7 % slower).
     let mut leaf_splits = true;
+    let mut areas = [c.bounds.half_area(); 8];
     let mut n = 1;
     while n < 8 {
         let area = |i: usize| {
             let k = &kids[i];
             if k.len() > LEAF_SIZE || (k.len() >= 2 && leaf_splits) {
-                k.bounds.half_area()
+                areas[i]
             } else {
                 -1.0
             }
@@ -429,6 +519,7 @@ fn open(prims: &mut [Bounds], ids: &mut [u32], c: Cluster, bins: &mut Bins) -> (
             continue;
         };
         (kids[i], kids[n]) = (l, r);
+        (areas[i], areas[n]) = (l.bounds.half_area(), r.bounds.half_area());
         n += 1;
     }
     kids[..n].sort_unstable_by_key(|k| k.start);

@@ -160,14 +160,27 @@ macro_rules! closest_body {
                     cur = node.child[mask.trailing_zeros() as usize];
                     continue;
                 }
-                // Two or more: sort by entry distance (non-negative, so its bits sort as integers;
+                // Two or more: order by entry distance (non-negative, so its bits sort as integers;
                 // the low three bits carry the slot), push all but the nearest, farthest first.
+                let key = |slot: u32| (t_near[slot as usize].to_bits() & !7) | slot;
+                let first = mask.trailing_zeros();
+                let rest = mask & (mask - 1);
+                if rest & (rest - 1) == 0 {
+                    // Exactly two (the most common case): one comparison.
+                    let (a, b) = (key(first), key(rest.trailing_zeros()));
+                    let (near, far) = if a < b { (a, b) } else { (b, a) };
+                    stack[sp] =
+                        MaybeUninit::new(Entry { child: node.child[(far & 7) as usize], t: f32::from_bits(far & !7) });
+                    sp += 1;
+                    cur = node.child[(near & 7) as usize];
+                    continue;
+                }
                 let mut keys = [0u32; 8];
                 let mut n = 0;
                 while mask != 0 {
                     let slot = mask.trailing_zeros();
                     mask &= mask - 1;
-                    let key = (t_near[slot as usize].to_bits() & !7) | slot;
+                    let key = key(slot);
                     let mut i = n;
                     while i > 0 && keys[i - 1] < key {
                         keys[i] = keys[i - 1];
@@ -220,11 +233,19 @@ macro_rules! any_body {
             if cur & LEAF == 0 {
                 let node = &bvh.nodes[cur as usize];
                 let mut mask = $node_test!(node, &nr, tmax, &mut t_near);
-                while mask != 0 {
-                    let slot = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    stack[sp] = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
-                    sp += 1;
+                if mask != 0 {
+                    // Descend into the hit child of the highest slot; push the others (lowest
+                    // first, so they are visited from the highest down).
+                    let last = 31 - mask.leading_zeros();
+                    mask &= !(1 << last);
+                    while mask != 0 {
+                        let slot = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack[sp] = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
+                        sp += 1;
+                    }
+                    cur = node.child[last as usize];
+                    continue;
                 }
             } else if wt.any4(&bvh.packets[(cur & !LEAF) as usize], tmax) {
                 break true;
