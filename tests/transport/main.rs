@@ -16,3 +16,4 @@ mod manifold_unbiased;
 mod snee_degenerate;
 mod snee_slab;
 mod snee_unbiased;
+mod manifold_rough_curved;

@@ -1,35 +1,40 @@
-//! Manifold NEE through a flat ROUGH boundary (`roughdielectric`, GGX or Beckmann, isotropic, any
+//! Manifold NEE through a ROUGH boundary (`roughdielectric`, GGX or Beckmann, isotropic, any
 //! `alpha`): from a medium vertex `x_j`, connect to a DIRECTIONAL light or the ENVIRONMENT through a
-//! microfacet refraction at the boundary (docs/manifold.md §7).
+//! microfacet refraction at the boundary (docs/manifold.md §7, §7.1).
 //!
-//! On a flat facet the interface looks the same everywhere, so the inner direction can be sampled
-//! from the light side without knowing where `x_k` is: `omega_in ~ bsdf.sample` with `wi = omega_l`
-//! in importance mode (a visible microfacet normal seen from the light, refracted; a sampled
-//! reflection fails), then `x_k` is the first hit from `x_j` along `omega_jk = −omega_in`, which
-//! must lie on that plane of the enclosing boundary. Conditioned on `x_j`, the density of
-//! `omega_jk` (solid angle at `x_j`) is
+//! The inner direction is sampled from the light side without knowing where `x_k` is:
+//! `omega_in ~ bsdf.sample` with `wi = omega_l` in importance mode, in a [`Reference`] frame (a
+//! visible microfacet normal seen from the light, refracted; a sampled reflection fails), then
+//! `x_k` is the first hit from `x_j` along `omega_jk = −omega_in`. On a FLAT boundary the frame is
+//! each plane orientation's (one sample per orientation; `x_k` must lie on that plane); on a
+//! CURVED one (interpolated normals, spheres) it is the shading frame where the straight line from
+//! `x_j` towards the light meets the boundary ([`curved_reference`], one ray), a deterministic
+//! function of `(x_j, omega_l)`, so the density stays evaluable for any path. Conditioned on `x_j`,
+//! the density of `omega_jk` (solid angle at `x_j`) is
 //!
 //! ```text
-//! p_man = p_light · p_imp(omega_in | omega_l)        (p_imp = bsdf.pdf in importance mode)
+//! p_man = p_light · p_imp(omega_in | omega_l, reference)     (p_imp = bsdf.pdf in importance mode)
 //! ```
 //!
 //! (`p_light`: `p_sel` for a directional light, `p_env(omega_l)` for the environment, whose
 //! densities are then also per solid angle of `omega_l`)
 //!
 //! and the estimate `f_p(wi_j, ω_jk) T(d_jk) f_s(x_k; ω_kj → ω_l) tr_light · E / p_man`, with
-//! `f_s` Mitsuba's radiance-mode `eval` (cosine of `ω_l` included). Every plane orientation of the
-//! boundary gets its own sample (the sets of paths through different orientations are disjoint).
-//! The competitors for the same suffix `x_j → x_k → light`, in the same measure ([`rough_pdfs`]):
-//! forward NEE at `x_k` (`f_p e^{−σ_t d_jk} p_light`), forward BSDF sampling (`f_p e^{−σ_t d_jk}
-//! bsdf.pdf(ω_kj → ω_l)`, 0 for a delta light, [`bsdf_hit_weight`]) and SNEE from the vertex `x_i` before `x_j` (its `dV(x_j) dA(x_k)` density over
-//! forward's density of `x_j` and `dA(x_k)/dω_jk`). The power heuristic over the four,
-//! [`rough_weight`], is computed by the same function at the three places that make such a
-//! suffix: this connection ([`sample`]), forward NEE at `x_k` ([`nee_weight`], through the
-//! manifold stage) and SNEE ([`snee_weight`], through `manifold::snee_weight`).
+//! `f_s` Mitsuba's radiance-mode `eval` in the TRUE shading frame at `x_k` (cosine of `ω_l`
+//! included). The competitors for the same suffix `x_j → x_k → light`, in the same measure
+//! ([`rough_pdfs`]): forward NEE at `x_k` (`f_p e^{−σ_t d_jk} p_light`), forward BSDF sampling
+//! (`f_p e^{−σ_t d_jk} bsdf.pdf(ω_kj → ω_l)`, 0 for a delta light, [`bsdf_hit_weight`]) and SNEE
+//! from the vertex `x_i` before `x_j` (its `dV(x_j) dA(x_k)` density over forward's density of
+//! `x_j` and `dA(x_k)/dω_jk`). The power heuristic over the four, [`rough_weight`], is computed
+//! by the same function at the places that make such a suffix: this connection ([`sample`]),
+//! forward NEE at `x_k` ([`nee_weight`], through the manifold stage), forward BSDF sampling
+//! ([`bsdf_hit_weight`]) and SNEE ([`snee_weight`], through `manifold::snee_weight`); each
+//! recomputes the connection's reference from the path's own `x_j`. Where the connection's density
+//! is 0 (outside its support, see docs/manifold.md §7.1) the others' weights sum to 1.
 //!
 //! Scope: directional lights and the environment (area and point lights through a rough boundary
 //! keep the paper's estimator: the connection contributes nothing for them, so its density is 0
-//! and their weights are unchanged); isotropic roughness (the plane's frame then does not matter).
+//! and their weights are unchanged); isotropic roughness.
 
 use super::planes::{MAX_PLANES, SAME_NORMAL};
 use super::{light_segment, MediumVertex};
@@ -604,6 +609,33 @@ mod tests {
                 7,
             );
             assert!(r.passed, "{kind:?} alpha {alpha} eta {eta}\n{}", r.report);
+        }
+    }
+
+    /// The same in a shading frame with a rotated tangent (the reference frame of a curved
+    /// boundary, docs/manifold.md §7.1), GGX α = 0.2 and 0.04 (the statue's), light from 0° to
+    /// 70° off the frame's normal. Sample counts chosen before the first run.
+    #[test]
+    fn inner_direction_sampling_in_a_shading_frame_matches_pdf() {
+        let n = Vec3::new(-0.4, 0.1, 0.9).normalize();
+        let base = Frame::from_normal(n);
+        let (c, s) = (0.6f32.cos(), 0.6f32.sin());
+        let frame = Frame { s: base.s * c + base.t * s, t: base.t * c - base.s * s, n };
+        let cases = [(0.2, 0.0), (0.2, 1.2), (0.04, 0.5), (0.04, 1.2)];
+        let level = sidak(0.01, cases.len());
+        for (alpha, theta) in cases {
+            let bsdf = rough(MicrofacetType::Ggx, alpha, 1.5);
+            let omega_l = frame.to_world(Vec3::new(f32::sin(theta), 0.0, f32::cos(theta)));
+            let r = chi2_sphere(
+                |u1, u2| sample_inner_in(&bsdf, frame, omega_l, u1, u2),
+                |d| pdf_inner_in(&bsdf, frame, omega_l, d) as f32,
+                32,
+                64,
+                400_000,
+                level,
+                11,
+            );
+            assert!(r.passed, "alpha {alpha} theta {theta}\n{}", r.report);
         }
     }
 
