@@ -38,6 +38,7 @@
 
 use super::planes::{MAX_PLANES, SAME_NORMAL};
 use super::{light_segment, MediumVertex};
+use crate::bsdf::fresnel::{fresnel, refract};
 use crate::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use crate::color::Spectrum;
 use crate::integrator::cx::{Cx, Scatter};
@@ -131,11 +132,14 @@ impl Reference {
 }
 
 /// The reference of the connection from `p_j` (inside `medium`) towards a light in the direction
-/// `omega_l` through a CURVED rough boundary (docs/manifold.md §7.1): the shading frame and BSDF at
-/// the first hit of the ray `(p_j, omega_l)`, when that hit is `medium`'s enclosing rough boundary
-/// met from inside; `None` otherwise (then the connection's density is 0 for every suffix from
-/// `p_j` towards `omega_l`). A deterministic function of `(p_j, omega_l)`: every technique that
-/// evaluates the connection's density recomputes it from the path's own `x_j` (one ray).
+/// `omega_l` through a CURVED rough boundary (docs/manifold.md §7.1): `x_0`, the first hit of the
+/// ray `(p_j, omega_l)`, must be `medium`'s enclosing rough boundary met from inside (else `None`:
+/// the connection's density is 0 for every suffix from `p_j` towards `omega_l`); then `x_1`, the
+/// first hit along the reverse of `omega_l` refracted smoothly about `x_0`'s shading normal (where
+/// the α → 0 solution about lands); the reference is `x_1`'s shading frame and BSDF, or `x_0`'s
+/// when that refraction is total or `x_1` is not on the boundary. A deterministic function of
+/// `(p_j, omega_l)`: every technique that evaluates the connection's density recomputes it from
+/// the path's own `x_j` (two rays).
 pub fn curved_reference(
     scene: &Scene,
     medium: u32,
@@ -144,9 +148,23 @@ pub fn curved_reference(
     stats: &mut LocalStats,
 ) -> Option<Reference> {
     stats.rays += 1;
-    let si = scene.ray_intersect(&Ray::new(p_j, omega_l))?;
-    on_boundary(scene, &si, medium, omega_l)
-        .then(|| Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf })
+    let si0 = scene.ray_intersect(&Ray::new(p_j, omega_l))?;
+    if !on_boundary(scene, &si0, medium, omega_l) {
+        return None;
+    }
+    let of = |si: &SurfaceInteraction| Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf };
+    let Bsdf::RoughDielectric(b) = scene.bsdf(&si0) else { return Some(of(&si0)) };
+    let wl = si0.to_local(omega_l);
+    let (f, cos_t, _, eta_ti) = fresnel(wl.z, b.eta);
+    if !(wl.z > 0.0) || f >= 1.0 {
+        return Some(of(&si0));
+    }
+    let d1 = -si0.to_world(refract(wl, cos_t, eta_ti)).normalize();
+    stats.rays += 1;
+    match scene.ray_intersect(&Ray::new(p_j, d1)) {
+        Some(si1) if on_boundary(scene, &si1, medium, d1) => Some(of(&si1)),
+        _ => Some(of(&si0)),
+    }
 }
 
 /// The reference in which the connection at `x_j` would have sampled a suffix towards `omega_l`
