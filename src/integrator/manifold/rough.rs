@@ -153,19 +153,26 @@ pub fn curved_reference(
         return None;
     }
     let of = |si: &SurfaceInteraction| Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf };
-    let Bsdf::RoughDielectric(b) = scene.bsdf(&si0) else { return Some(of(&si0)) };
-    let wl = si0.to_local(omega_l);
-    let (f, cos_t, _, eta_ti) = fresnel(wl.z, b.eta);
-    if !(wl.z > 0.0) || f >= 1.0 {
-        return Some(of(&si0));
+    let mut si = si0;
+    for _ in 0..REFINE_STEPS {
+        let Bsdf::RoughDielectric(b) = scene.bsdf(&si) else { break };
+        let wl = si.to_local(omega_l);
+        let (f, cos_t, _, eta_ti) = fresnel(wl.z, b.eta);
+        if !(wl.z > 0.0) || f >= 1.0 {
+            break;
+        }
+        let d = -si.to_world(refract(wl, cos_t, eta_ti)).normalize();
+        stats.rays += 1;
+        match scene.ray_intersect(&Ray::new(p_j, d)) {
+            Some(next) if on_boundary(scene, &next, medium, d) => si = next,
+            _ => break,
+        }
     }
-    let d1 = -si0.to_world(refract(wl, cos_t, eta_ti)).normalize();
-    stats.rays += 1;
-    match scene.ray_intersect(&Ray::new(p_j, d1)) {
-        Some(si1) if on_boundary(scene, &si1, medium, d1) => Some(of(&si1)),
-        _ => Some(of(&si0)),
-    }
+    Some(of(&si))
 }
+
+/// Refinement steps of [`curved_reference`] (each one ray at every evaluation of the density).
+const REFINE_STEPS: usize = 2;
 
 /// The reference in which the connection at `x_j` would have sampled a suffix towards `omega_l`
 /// whose boundary point is on `plane` (flat) or anywhere on a curved boundary (`plane = None`).
