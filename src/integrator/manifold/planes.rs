@@ -56,10 +56,14 @@ pub struct RoughPlane {
     pub bsdf: u32,
 }
 
-/// The flat rough boundary of one medium: its distinct (normal, BSDF) orientations.
+/// The rough boundary of one medium: its distinct (normal, BSDF) orientations when it is flat, or
+/// `curved` (meshes with interpolated normals, spheres, more than [`MAX_PLANES`] orientations:
+/// `planes` is then empty and the connection samples in a reference frame found from `x_j`,
+/// docs/manifold.md §7.1).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RoughBoundary {
     pub planes: Vec<RoughPlane>,
+    pub curved: bool,
 }
 
 impl RoughBoundary {
