@@ -73,6 +73,11 @@ pub struct RenderStats {
     pub manifold_newton_failures: u64,
     pub manifold_newton_lost: u64,
     pub manifold_trials_capped: u64,
+    pub chain_attempts: u64,
+    pub chain_solves: u64,
+    pub chain_iterations: u64,
+    pub chain_solutions: u64,
+    pub chain_trials_capped: u64,
 }
 
 impl RenderStats {
@@ -96,6 +101,11 @@ impl RenderStats {
             "manifold_newton_failures": self.manifold_newton_failures,
             "manifold_newton_lost": self.manifold_newton_lost,
             "manifold_trials_capped": self.manifold_trials_capped,
+            "chain_attempts": self.chain_attempts,
+            "chain_solves": self.chain_solves,
+            "chain_iterations": self.chain_iterations,
+            "chain_solutions": self.chain_solutions,
+            "chain_trials_capped": self.chain_trials_capped,
         })
     }
 }
@@ -444,6 +454,11 @@ pub fn render_range(
             manifold_newton_failures: stats.manifold_newton_failures.load(Ordering::Relaxed),
             manifold_newton_lost: stats.manifold_newton_lost.load(Ordering::Relaxed),
             manifold_trials_capped: stats.manifold_trials_capped.load(Ordering::Relaxed),
+            chain_attempts: stats.chain_attempts.load(Ordering::Relaxed),
+            chain_solves: stats.chain_solves.load(Ordering::Relaxed),
+            chain_iterations: stats.chain_iterations.load(Ordering::Relaxed),
+            chain_solutions: stats.chain_solutions.load(Ordering::Relaxed),
+            chain_trials_capped: stats.chain_trials_capped.load(Ordering::Relaxed),
         },
     }
 }

@@ -17,6 +17,11 @@ pub struct Stats {
     pub manifold_newton_failures: AtomicU64,
     pub manifold_newton_lost: AtomicU64,
     pub manifold_trials_capped: AtomicU64,
+    pub chain_attempts: AtomicU64,
+    pub chain_solves: AtomicU64,
+    pub chain_iterations: AtomicU64,
+    pub chain_solutions: AtomicU64,
+    pub chain_trials_capped: AtomicU64,
 }
 
 /// Thread-local counters, flushed into [`Stats`] once per tile.
@@ -46,6 +51,16 @@ pub struct LocalStats {
     pub manifold_newton_lost: u64,
     /// Specular manifold sampling's Bernoulli trials stopped at the cap (`newton::MAX_TRIALS`).
     pub manifold_trials_capped: u64,
+    /// Two-vertex chains run (`manifold/chain.rs`, one emitter sample at a medium vertex).
+    pub chain_attempts: u64,
+    /// Newton solves of the chain, one per seed.
+    pub chain_solves: u64,
+    /// Newton iterations of the chain summed over its solves.
+    pub chain_iterations: u64,
+    /// Chains found and verified (both boundary points, the light segment).
+    pub chain_solutions: u64,
+    /// The chain's Bernoulli trials stopped at the cap (`chain::MAX_TRIALS`).
+    pub chain_trials_capped: u64,
 }
 
 impl Stats {
@@ -62,5 +77,10 @@ impl Stats {
         self.manifold_newton_failures.fetch_add(l.manifold_newton_failures, Ordering::Relaxed);
         self.manifold_newton_lost.fetch_add(l.manifold_newton_lost, Ordering::Relaxed);
         self.manifold_trials_capped.fetch_add(l.manifold_trials_capped, Ordering::Relaxed);
+        self.chain_attempts.fetch_add(l.chain_attempts, Ordering::Relaxed);
+        self.chain_solves.fetch_add(l.chain_solves, Ordering::Relaxed);
+        self.chain_iterations.fetch_add(l.chain_iterations, Ordering::Relaxed);
+        self.chain_solutions.fetch_add(l.chain_solutions, Ordering::Relaxed);
+        self.chain_trials_capped.fetch_add(l.chain_trials_capped, Ordering::Relaxed);
     }
 }

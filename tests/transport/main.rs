@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod manifold_chain;
 mod manifold_curved;
 mod manifold_finite;
 mod manifold_oblique;

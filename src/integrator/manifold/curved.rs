@@ -96,7 +96,7 @@ impl Locate for SceneLocate<'_> {
 }
 
 /// The closed-form patch of the boundary hit `si` (reached from inside `medium` along `d`).
-fn boundary_patch(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3) -> Option<Patch> {
+pub(super) fn boundary_patch(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3) -> Option<Patch> {
     let s = &scene.shapes[si.shape as usize];
     if s.interior != Some(medium) || s.exterior.is_some() || !(d.dot(si.n) > 0.0) {
         return None;

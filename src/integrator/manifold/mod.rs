@@ -29,6 +29,7 @@
 //! `snee/sample.rs`). The flat boundaries are built at scene load into `volpath_snee`'s tables
 //! ([`Snee::flat`], read through [`tables`]).
 
+pub mod chain;
 pub mod curved;
 pub mod finite;
 pub mod flat;
@@ -184,7 +185,10 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     let (scene, channel, sampler, stats) = (cx.scene, cx.channel, &mut *cx.sampler, &mut *cx.stats);
     let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
     let (beta, depth, max_depth) = (v.beta, v.depth, v.max_depth);
-    let Some(boundary) = boundary_of(scene, x_j.medium) else { return curved::sample(cx, opts, x_i, v) };
+    let Some(boundary) = boundary_of(scene, x_j.medium) else {
+        // Curved boundary: one refraction, then the two-vertex chain (reflection, refraction).
+        return curved::sample(cx, opts, x_i, v).map(|r| r + chain::sample(cx, opts, v));
+    };
     let u: Vec2 = sampler.next_2d();
     // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).
     if depth.saturating_add(1) >= max_depth {
