@@ -73,6 +73,8 @@ pub struct RenderStats {
     pub manifold_newton_failures: u64,
     pub manifold_newton_lost: u64,
     pub manifold_trials_capped: u64,
+    pub manifold_resolves: u64,
+    pub manifold_resolve_matches: u64,
 }
 
 impl RenderStats {
@@ -96,6 +98,8 @@ impl RenderStats {
             "manifold_newton_failures": self.manifold_newton_failures,
             "manifold_newton_lost": self.manifold_newton_lost,
             "manifold_trials_capped": self.manifold_trials_capped,
+            "manifold_resolves": self.manifold_resolves,
+            "manifold_resolve_matches": self.manifold_resolve_matches,
         })
     }
 }
@@ -444,6 +448,8 @@ pub fn render_range(
             manifold_newton_failures: stats.manifold_newton_failures.load(Ordering::Relaxed),
             manifold_newton_lost: stats.manifold_newton_lost.load(Ordering::Relaxed),
             manifold_trials_capped: stats.manifold_trials_capped.load(Ordering::Relaxed),
+            manifold_resolves: stats.manifold_resolves.load(Ordering::Relaxed),
+            manifold_resolve_matches: stats.manifold_resolve_matches.load(Ordering::Relaxed),
         },
     }
 }

@@ -17,6 +17,8 @@ pub struct Stats {
     pub manifold_newton_failures: AtomicU64,
     pub manifold_newton_lost: AtomicU64,
     pub manifold_trials_capped: AtomicU64,
+    pub manifold_resolves: AtomicU64,
+    pub manifold_resolve_matches: AtomicU64,
 }
 
 /// Thread-local counters, flushed into [`Stats`] once per tile.
@@ -46,6 +48,10 @@ pub struct LocalStats {
     pub manifold_newton_lost: u64,
     /// Specular manifold sampling's Bernoulli trials stopped at the cap (`newton::MAX_TRIALS`).
     pub manifold_trials_capped: u64,
+    /// Re-solves from a path's own seed to evaluate the curved finite-light connection's density
+    /// for a suffix forward tracing or SNEE made (`curved_finite.rs`), and those that found it.
+    pub manifold_resolves: u64,
+    pub manifold_resolve_matches: u64,
 }
 
 impl Stats {
@@ -62,5 +68,7 @@ impl Stats {
         self.manifold_newton_failures.fetch_add(l.manifold_newton_failures, Ordering::Relaxed);
         self.manifold_newton_lost.fetch_add(l.manifold_newton_lost, Ordering::Relaxed);
         self.manifold_trials_capped.fetch_add(l.manifold_trials_capped, Ordering::Relaxed);
+        self.manifold_resolves.fetch_add(l.manifold_resolves, Ordering::Relaxed);
+        self.manifold_resolve_matches.fetch_add(l.manifold_resolve_matches, Ordering::Relaxed);
     }
 }

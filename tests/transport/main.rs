@@ -7,6 +7,7 @@
 mod common;
 
 mod manifold_curved;
+mod manifold_curved_finite;
 mod manifold_finite;
 mod manifold_oblique;
 mod manifold_options;

@@ -30,10 +30,12 @@
 //! ([`Snee::flat`], read through [`tables`]).
 
 pub mod curved;
+pub mod curved_finite;
 pub mod finite;
 pub mod flat;
 pub mod mis;
 pub mod newton;
+pub mod newton_point;
 pub mod pdf;
 pub mod planes;
 pub mod rough;
@@ -413,6 +415,9 @@ pub fn snee_weight(
     }
     if let Some(rb) = rough::boundary_of(scene, s.x_i.medium) {
         return rough::snee_weight(scene, technique, rb, s, light, channel);
+    }
+    if let Some(w) = curved_finite::snee_weight(scene, technique, s, light, channel) {
+        return Some(w);
     }
     let boundary = boundary_of(scene, s.x_i.medium)?;
     let si_k = &s.si_k;
