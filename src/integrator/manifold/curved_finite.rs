@@ -114,18 +114,32 @@ fn pdfs(
     EnvPdfs { manifold: finite(manifold), forward: finite(forward), snee: finite(snee) }
 }
 
+/// Does the light's front at `y` (normal `n_y`) face `x_j`? The connection solves only then (a
+/// function of `(x_j, y)`, part of its density: saves the solves towards the back half of a sphere
+/// light; the few suffixes near the silhouette it excludes are forward tracing's and SNEE's).
+#[inline]
+fn faces(n_y: Vec3, y: Vec3, x_j: Vec3) -> bool {
+    n_y.dot(x_j - y) > 0.0
+}
+
 /// The connection's density of the suffix `x_j → x_k → y` that another technique made along
 /// `omega_jk`: re-solve from the path's own seed `(x_j, y)` and keep `p_sel p_A(y) / (G |cos θ_y|)`
-/// when Newton lands on this `omega_jk`, else 0. `p_y`: `p_sel p_A(y)`; `cos_y` at `y`.
+/// when Newton lands on this `omega_jk`, else 0 (and 0 when [`faces`] is false). `p_y`:
+/// `p_sel p_A(y)`; `n_y`, `cos_y` at `y`.
+#[allow(clippy::too_many_arguments)]
 fn density(
     scene: &Scene,
     x_j: &MediumVertex,
     omega_jk: Vec3,
     y: Vec3,
+    n_y: Vec3,
     p_y: f64,
     cos_y: f32,
     stats: &mut LocalStats,
 ) -> f64 {
+    if !faces(n_y, y, x_j.p) {
+        return 0.0;
+    }
     stats.manifold_resolves += 1;
     match resolve(scene, x_j, y, stats) {
         Some((sol, _)) if (sol.omega - omega_jk.as_dvec3()).length() < SAME_SOLUTION => {
@@ -157,6 +171,9 @@ pub fn sample(
     let (Some((n_y, uv)), SceneEmitter::Area { radiance, .. }) = (lp.area, &scene.emitters[lp.emitter as usize]) else {
         return Spectrum::ZERO;
     };
+    if !faces(n_y, lp.y, x_j.p) {
+        return fail(stats);
+    }
     let Some((sol, si_k)) = resolve(scene, x_j, lp.y, stats) else { return fail(stats) };
     let to_y = lp.y - si_k.p;
     let d_ky = to_y.length();
@@ -243,7 +260,7 @@ pub fn forward_weight(
     scene.shapes[y.shape as usize].emitter?;
     let (p_y, cos_y) = finite::area_point_density(scene, y, omega_l);
     let d_jk = (p.si_k.p - p.x_j.p).length();
-    let p_man = density(scene, &p.x_j, p.omega_jk, y.p, p_y, cos_y, stats);
+    let p_man = density(scene, &p.x_j, p.omega_jk, y.p, y.n, p_y, cos_y, stats);
     let ds = scene.direction_sample_for_hit(p.si_k.p, y);
     let light = LightSample::hit(omega_l, y.p, ds.dist, scene.pdf_emitter_direction(p.si_k.p, &ds));
     let pd = pdfs(scene, opts, p.x_i.as_ref(), &p.x_j, &p.si_k, p.omega_jk, d_jk, &light, p_man, channel, true, stats);
@@ -265,13 +282,14 @@ pub fn snee_weight(
     }
     let opts = SneeOptions { technique, ..scene.integrator.snee };
     let mut no_stats = LocalStats::default();
-    let (p_y, cos_y) = finite::area_point(scene, &s.si_k, light.omega_l)?;
+    let hit = finite::area_point_hit(scene, &s.si_k, light.omega_l)?;
+    let (p_y, cos_y) = finite::area_point_density(scene, &hit, light.omega_l);
     let v_ij = s.x_j - s.x_i.p;
     let x_j = MediumVertex { p: s.x_j, wi: -v_ij / v_ij.length(), medium: s.x_i.medium };
     let v_jk = s.si_k.p - s.x_j;
     let d_jk = v_jk.length();
     let omega_jk = v_jk / d_jk;
-    let p_man = density(scene, &x_j, omega_jk, light.p, p_y, cos_y, &mut no_stats);
+    let p_man = density(scene, &x_j, omega_jk, light.p, hit.n, p_y, cos_y, &mut no_stats);
     let p = pdfs(scene, opts, Some(&s.x_i), &x_j, &s.si_k, omega_jk, d_jk, light, p_man, channel, false, &mut no_stats);
     Some(mis::env_weight(opts, EnvTechnique::Snee, p))
 }
