@@ -65,3 +65,46 @@ fn sphere_light_through_matched_pebble_agrees_with_null_boundary() {
     );
     assert!(report.is_empty(), "volpath vs complete:\n{report}");
 }
+
+/// The three techniques' weights of the same suffix, each computed where that technique would
+/// compute it (the connection's own weight; a forward path's weight at the light hit, re-solving
+/// from the path's seed; SNEE's weight for its sample), sum to 1 on suffixes the connection
+/// samples in the glass pebble (x_i, x_j random inside, `y` from the connection's own emitter
+/// sample). 400 attempts, chosen before the first run.
+#[test]
+fn technique_weights_sum_to_one_on_sampled_suffixes() {
+    use snee::integrator::manifold::{curved_finite, finite, MediumVertex};
+    use snee::integrator::snee::SneeVertex;
+    use snee::integrator::stats::LocalStats;
+    use snee::interaction::offset_origin;
+    use snee::math::{Ray, Vec2, Vec3};
+    let scene = scene(&mesh("volpath_snee", COMPLETE, GLASS, "pebble.ply"), &[]);
+    let opts = scene.integrator.snee;
+    let mut rng = snee::sampler::Sampler::new(11, 1);
+    let mut stats = LocalStats::default();
+    let (mut checked, mut shared, mut worst) = (0, 0, 0.0f64);
+    for _ in 0..400 {
+        let mut u3 = || Vec3::new(rng.next_1d(), rng.next_1d(), rng.next_1d()) - Vec3::splat(0.5);
+        let x_i = SneeVertex { p: u3() * 0.4, wi: u3().normalize(), medium: 0, rate: 1.0 };
+        let p_j = x_i.p + u3() * 0.3;
+        let x_j = MediumVertex { p: p_j, wi: (x_i.p - p_j).normalize(), medium: 0 };
+        let finite::Pick::Finite(lp) = finite::pick(&scene, Vec2::new(rng.next_1d(), rng.next_1d())) else {
+            panic!("the sphere light is the only emitter")
+        };
+        let Some(c) = curved_finite::connect(&scene, opts, Some(&x_i), &x_j, &lp, 0, &mut stats) else { continue };
+        // The forward path: the same suffix, the light hit along the refracted direction.
+        let omega_l = c.light.omega_l;
+        let hit = scene.ray_intersect(&Ray::new(offset_origin(c.si_k.p, c.si_k.n, omega_l), omega_l)).expect("hits");
+        let pending = curved_finite::Pending { x_i: Some(x_i), x_j, si_k: c.si_k, omega_jk: c.omega };
+        let w_fwd = curved_finite::forward_weight(&scene, opts, &pending, &hit, omega_l, 0, &mut stats).unwrap() as f64;
+        let suffix = snee::integrator::snee::SneeSuffix { x_i, x_j: x_j.p, si_k: c.si_k };
+        let w_snee = curved_finite::snee_weight(&scene, opts.technique, &suffix, &c.light, 0).unwrap();
+        let sum = c.weight + w_fwd + w_snee;
+        worst = worst.max((sum - 1.0).abs());
+        checked += 1;
+        shared += (c.weight < 0.99 && (w_fwd > 0.01 || w_snee > 0.01)) as u32;
+    }
+    eprintln!("{checked} suffixes, {shared} shared (no weight above 0.99); worst |Σw − 1| = {worst:.2e}");
+    assert!(checked > 50 && shared > 5, "too few suffixes checked ({checked}, {shared} shared)");
+    assert!(worst < 1e-2, "weights sum to 1 ± {worst}");
+}

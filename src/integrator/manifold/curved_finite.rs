@@ -150,26 +150,37 @@ fn density(
     }
 }
 
-/// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`): solve, verify,
-/// value, and MIS-weight against forward tracing and SNEE. Returns the weighted contribution
-/// (with `beta`).
+/// One verified connection: its value `f / p` (without the path throughput), its MIS weight, and
+/// the suffix (for the weights' consistency test).
+#[derive(Clone, Copy, Debug)]
+pub struct PointConnection {
+    pub value: Spectrum,
+    pub weight: f64,
+    pub si_k: SurfaceInteraction,
+    /// Unit direction `x_j → x_k`.
+    pub omega: Vec3,
+    pub light: LightSample,
+}
+
+/// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`): solve from the
+/// deterministic seed, verify, value, and MIS-weight against forward tracing and SNEE. Counts
+/// solutions and failures.
 #[allow(clippy::too_many_arguments)]
-pub fn sample(
+pub fn connect(
     scene: &Scene,
     opts: SneeOptions,
     x_i: Option<&SneeVertex>,
     x_j: &MediumVertex,
     lp: &LightPoint,
-    beta: Spectrum,
     channel: usize,
     stats: &mut LocalStats,
-) -> Spectrum {
+) -> Option<PointConnection> {
     let fail = |stats: &mut LocalStats| {
         stats.manifold_failures += 1;
-        Spectrum::ZERO
+        None
     };
     let (Some((n_y, uv)), SceneEmitter::Area { radiance, .. }) = (lp.area, &scene.emitters[lp.emitter as usize]) else {
-        return Spectrum::ZERO;
+        return None;
     };
     if !faces(n_y, lp.y, x_j.p) {
         return fail(stats);
@@ -200,9 +211,26 @@ pub fn sample(
     let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
     let p_man = mis::area_density(lp.p_y, sol.g, cos_y);
     let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
-    let w = mis::env_weight(opts, EnvTechnique::Manifold, p);
+    let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
+    Some(PointConnection { value, weight, si_k, omega, light })
+}
+
+/// The connection's weighted contribution at `x_j` (with `beta`), zero when it fails.
+#[allow(clippy::too_many_arguments)]
+pub fn sample(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    lp: &LightPoint,
+    beta: Spectrum,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Spectrum {
     let mut result = Spectrum::ZERO;
-    add_finite(&mut result, beta * value * w as f32, stats);
+    if let Some(c) = connect(scene, opts, x_i, x_j, lp, channel, stats) {
+        add_finite(&mut result, beta * c.value * c.weight as f32, stats);
+    }
     result
 }
 
