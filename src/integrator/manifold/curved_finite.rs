@@ -36,6 +36,11 @@ use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::{Ray, Vec3};
 use crate::scene::world::{Scene, SceneEmitter};
 
+/// Probability that the connection runs at a medium vertex whose emitter sample picked an area
+/// light (a constant, part of its density everywhere): each connection costs a Newton solve
+/// (docs/manifold.md §8.2, "Cost").
+pub const RATE: f64 = 0.1;
+
 /// Two directions are the same solution when they differ by less than this (radians).
 const SAME_SOLUTION: f64 = 1e-4;
 
@@ -144,7 +149,7 @@ fn density(
     match resolve(scene, x_j, y, stats) {
         Some((sol, _)) if (sol.omega - omega_jk.as_dvec3()).length() < SAME_SOLUTION => {
             stats.manifold_resolve_matches += 1;
-            mis::area_density(p_y, sol.g, cos_y)
+            RATE * mis::area_density(p_y, sol.g, cos_y)
         }
         _ => 0.0,
     }
@@ -162,9 +167,10 @@ pub struct PointConnection {
     pub light: LightSample,
 }
 
-/// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`): solve from the
-/// deterministic seed, verify, value, and MIS-weight against forward tracing and SNEE. Counts
-/// solutions and failures.
+/// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`), given that it runs
+/// (probability [`RATE`], the caller's draw): solve from the deterministic seed, verify, value
+/// (divided by [`RATE`]), and MIS-weight against forward tracing and SNEE. Counts solutions and
+/// failures.
 #[allow(clippy::too_many_arguments)]
 pub fn connect(
     scene: &Scene,
@@ -207,9 +213,9 @@ pub fn connect(
     let d_jk = si_k.t;
     let eta = sol.patch.eta as f32;
     let f = fresnel(sol.refracted.cos_out as f32, eta).0;
-    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / lp.p_y;
+    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (RATE * lp.p_y);
     let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
-    let p_man = mis::area_density(lp.p_y, sol.g, cos_y);
+    let p_man = RATE * mis::area_density(lp.p_y, sol.g, cos_y);
     let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
     let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
     Some(PointConnection { value, weight, si_k, omega, light })

@@ -298,6 +298,7 @@ mod tests {
     /// On a flat facet `G` is the closed form of docs/manifold.md §3.2 (`pdf::plane_geometry`).
     #[test]
     fn flat_limit_is_the_closed_form() {
+        let mut solved = 0;
         for eta in [1.5, 1.33, 1.0 / 1.33] {
             let mut flat = Flat { eta };
             for (x_j, y) in [
@@ -307,6 +308,7 @@ mod tests {
             ] {
                 let Ok(s) = solve_from_seed(&mut flat, x_j, y) else { continue };
                 check_solution(&s, x_j, y);
+                solved += 1;
                 let r = s.refracted;
                 let closed = super::super::pdf::plane_geometry(
                     r.t as f32,
@@ -318,6 +320,9 @@ mod tests {
                 assert!((s.g / closed - 1.0).abs() < 1e-4, "eta {eta}: G {} vs closed {closed}", s.g);
             }
         }
+        // Every configuration has a solution except where the light is beyond the critical angle
+        // of the rarer inside (η = 1/1.33).
+        assert!(solved >= 7, "only {solved} of 9 solved");
     }
 
     /// pdf integration on a glass ball: the technique's density of the direction `omega` at
