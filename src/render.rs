@@ -78,6 +78,8 @@ pub struct RenderStats {
     pub chain_iterations: u64,
     pub chain_solutions: u64,
     pub chain_trials_capped: u64,
+    pub manifold_resolves: u64,
+    pub manifold_resolve_matches: u64,
 }
 
 impl RenderStats {
@@ -106,6 +108,8 @@ impl RenderStats {
             "chain_iterations": self.chain_iterations,
             "chain_solutions": self.chain_solutions,
             "chain_trials_capped": self.chain_trials_capped,
+            "manifold_resolves": self.manifold_resolves,
+            "manifold_resolve_matches": self.manifold_resolve_matches,
         })
     }
 }
@@ -459,6 +463,8 @@ pub fn render_range(
             chain_iterations: stats.chain_iterations.load(Ordering::Relaxed),
             chain_solutions: stats.chain_solutions.load(Ordering::Relaxed),
             chain_trials_capped: stats.chain_trials_capped.load(Ordering::Relaxed),
+            manifold_resolves: stats.manifold_resolves.load(Ordering::Relaxed),
+            manifold_resolve_matches: stats.manifold_resolve_matches.load(Ordering::Relaxed),
         },
     }
 }

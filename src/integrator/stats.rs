@@ -22,6 +22,8 @@ pub struct Stats {
     pub chain_iterations: AtomicU64,
     pub chain_solutions: AtomicU64,
     pub chain_trials_capped: AtomicU64,
+    pub manifold_resolves: AtomicU64,
+    pub manifold_resolve_matches: AtomicU64,
 }
 
 /// Thread-local counters, flushed into [`Stats`] once per tile.
@@ -61,6 +63,10 @@ pub struct LocalStats {
     pub chain_solutions: u64,
     /// The chain's Bernoulli trials stopped at the cap (`chain::MAX_TRIALS`).
     pub chain_trials_capped: u64,
+    /// Re-solves from a path's own seed to evaluate the curved finite-light connection's density
+    /// for a suffix forward tracing or SNEE made (`curved_finite.rs`), and those that found it.
+    pub manifold_resolves: u64,
+    pub manifold_resolve_matches: u64,
 }
 
 impl Stats {
@@ -82,5 +88,7 @@ impl Stats {
         self.chain_iterations.fetch_add(l.chain_iterations, Ordering::Relaxed);
         self.chain_solutions.fetch_add(l.chain_solutions, Ordering::Relaxed);
         self.chain_trials_capped.fetch_add(l.chain_trials_capped, Ordering::Relaxed);
+        self.manifold_resolves.fetch_add(l.manifold_resolves, Ordering::Relaxed);
+        self.manifold_resolve_matches.fetch_add(l.manifold_resolve_matches, Ordering::Relaxed);
     }
 }

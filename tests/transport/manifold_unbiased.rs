@@ -10,7 +10,8 @@
 //!   converges: the
 //!   connection to the environment, forward tracing and SNEE under the three-way power heuristic
 //!   (`snee = mis`), and with `snee = forward` (manifold + forward only) agree with `volpath`.
-//! - On a curved boundary (a glass sphere, not handled) the connection draws no samples:
+//! - On a curved boundary under a point light (a glass sphere; not handled: curved boundaries are
+//!   connected to directional, sphere and area lights only) the connection draws no samples:
 //!   `complete` renders bit for bit what `paper` renders. (Lights at a finite distance through
 //!   flat boundaries: `tests/manifold_finite.rs`.)
 //!
@@ -75,8 +76,7 @@ fn complete_agrees_with_volpath_under_envmap() {
 
 #[test]
 fn complete_is_paper_on_curved_boundary() {
-    let area = r#"<shape type="sphere"><point name="center" x="-2" y="1" z="3"/><float name="radius" value="0.5"/>
-        <emitter type="area"><rgb name="radiance" value="20, 20, 20"/></emitter></shape>"#;
+    let area = r#"<emitter type="point"><point name="position" x="-2" y="1" z="3"/><rgb name="intensity" value="8, 8, 8"/></emitter>"#;
     let glass = GLASS;
     let sphere =
         |integrator: &str| cube(integrator, glass, area).replace(r#"<shape type="cube">"#, r#"<shape type="sphere">"#);

@@ -45,10 +45,14 @@ use crate::shape::Geometry;
 
 /// Per medium of `scene`: does the curved connection apply (a smooth `dielectric` boundary made
 /// of meshes and spheres, not flat — flat boundaries take the closed form of `flat.rs`)?
-/// Only scenes with a directional light: elsewhere the connection would draw samples and
-/// contribute nothing (and `complete` renders bit for bit what `paper` renders).
+/// Only scenes with a directional or an area (sphere, rectangle, mesh) light: elsewhere the
+/// connection would draw samples and contribute nothing (and `complete` renders bit for bit what
+/// `paper` renders).
 pub fn curved_boundaries(scene: &Scene, flat: &[Option<super::planes::FlatBoundary>]) -> Vec<bool> {
-    let lit = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_))));
+    let lit = scene
+        .emitters
+        .iter()
+        .any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_)) | SceneEmitter::Area { .. }));
     (0..scene.media.len())
         .map(|m| lit && flat.get(m).is_none_or(|f| f.is_none()) && curved_boundary(scene, m as u32))
         .collect()
@@ -81,10 +85,10 @@ pub fn applies(scene: &Scene, medium: u32) -> bool {
 
 /// The scene as the Newton walk sees it: each step's ray cast from `x_j`, accepted when the first
 /// hit is `medium`'s enclosing smooth dielectric, met from inside.
-struct SceneLocate<'a> {
-    scene: &'a Scene,
-    medium: u32,
-    rays: u64,
+pub(super) struct SceneLocate<'a> {
+    pub(super) scene: &'a Scene,
+    pub(super) medium: u32,
+    pub(super) rays: u64,
 }
 
 impl Locate for SceneLocate<'_> {
@@ -221,9 +225,17 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
         return None;
     }
     stats.manifold_attempts += 1;
-    // The same emitter choice as the flat connection: only directional lights are connected here.
-    if !matches!(super::finite::pick(scene, u), super::finite::Pick::Distant) {
-        return Some(Spectrum::ZERO);
+    // The same emitter choice as the flat connection: directional lights here, area and sphere
+    // lights in `curved_finite.rs` (docs/manifold.md §8.2), nothing else.
+    match super::finite::pick(scene, u) {
+        super::finite::Pick::Distant => {}
+        super::finite::Pick::Finite(lp) if lp.area.is_some() => {
+            if (sampler.next_1d() as f64) >= super::curved_finite::RATE {
+                return Some(Spectrum::ZERO);
+            }
+            return Some(super::curved_finite::sample(scene, opts, x_i, &x_j, &lp, v.beta, channel, stats));
+        }
+        _ => return Some(Spectrum::ZERO),
     }
     let (ds, weight) = scene.sample_emitter_direction(x_j.p, None, u, false);
     if !(ds.pdf > 0.0) || ds.dist.is_finite() || !ds.delta || weight == Spectrum::ZERO {

@@ -177,11 +177,16 @@ const MAX_WALK: u32 = 64;
 /// manifold connection's density of it, `p_sel p_A(y)`, and `|cos θ_y|`. For SNEE's side of the
 /// MIS, which knows `y` but not its shape.
 pub fn area_point(scene: &Scene, si_k: &SurfaceInteraction, omega_l: Vec3) -> Option<(f64, f32)> {
+    area_point_hit(scene, si_k, omega_l).map(|hit| area_point_density(scene, &hit, omega_l))
+}
+
+/// The area-light point seen from `x_k` along `omega_l` through passable surfaces (the hit).
+pub fn area_point_hit(scene: &Scene, si_k: &SurfaceInteraction, omega_l: Vec3) -> Option<SurfaceInteraction> {
     let mut ray = Ray::new(offset_origin(si_k.p, si_k.n, omega_l), omega_l);
     for _ in 0..MAX_WALK {
         let hit = scene.ray_intersect(&ray)?;
         if scene.shapes[hit.shape as usize].emitter.is_some() {
-            return Some(area_point_density(scene, &hit, omega_l));
+            return Some(hit);
         }
         if !passable(scene, &hit) {
             return None;

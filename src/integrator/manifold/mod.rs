@@ -31,10 +31,12 @@
 
 pub mod chain;
 pub mod curved;
+pub mod curved_finite;
 pub mod finite;
 pub mod flat;
 pub mod mis;
 pub mod newton;
+pub mod newton_point;
 pub mod pdf;
 pub mod planes;
 pub mod rough;
@@ -417,6 +419,9 @@ pub fn snee_weight(
     }
     if let Some(rb) = rough::boundary_of(scene, s.x_i.medium) {
         return rough::snee_weight(scene, technique, rb, s, light, channel);
+    }
+    if let Some(w) = curved_finite::snee_weight(scene, technique, s, light, channel) {
+        return Some(w);
     }
     let boundary = boundary_of(scene, s.x_i.medium)?;
     let si_k = &s.si_k;

@@ -13,6 +13,7 @@
 //! SNEE's side of the MIS (a SNEE sample the connection could also have made) is one call in
 //! `snee/sample.rs` (`manifold::snee_weight`).
 
+use super::curved_finite;
 use super::rough::RoughPending;
 use super::track::{Pending, Tracker};
 use super::{forward_weight, Connection};
@@ -44,6 +45,9 @@ pub struct ManifoldStage<'a> {
     /// last surface carries it, and as it was when the ray reached the current surface.
     rough_pending: Option<RoughPending>,
     rough_arrived: Option<RoughPending>,
+    /// A path that left through a curved boundary right after `x_j` (`curved_finite.rs`), likewise.
+    curved_pending: Option<curved_finite::Pending>,
+    curved_arrived: Option<curved_finite::Pending>,
 }
 
 impl<'a> ManifoldStage<'a> {
@@ -57,6 +61,8 @@ impl<'a> ManifoldStage<'a> {
             x_i: None,
             rough_pending: None,
             rough_arrived: None,
+            curved_pending: None,
+            curved_arrived: None,
         })
     }
 
@@ -88,6 +94,7 @@ impl<'a> ManifoldStage<'a> {
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.arrived = self.tracker.surface_event();
         self.rough_arrived = self.rough_pending.take();
+        self.curved_arrived = self.curved_pending.take();
         self.hit = si.copied();
     }
 
@@ -109,6 +116,9 @@ impl<'a> ManifoldStage<'a> {
                 Some(_) => None,
             };
         }
+        if let (Some(cp), Some(y)) = (&self.curved_arrived, &self.hit) {
+            return curved_finite::forward_weight(scene, self.snee.options, cp, y, d, channel, stats);
+        }
         let opts = Some(self.snee.options);
         forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.hit.as_ref(), d, channel, stats)
     }
@@ -124,6 +134,8 @@ impl<'a> ManifoldStage<'a> {
         } else {
             None
         };
+        self.curved_pending =
+            curved_finite::pending(scene, self.x_i, self.tracker.x_j, s, bs, wo, self.curved_arrived.take());
         self.tracker.after_bsdf(scene, s, bs.sampled_type, wo, self.arrived.take());
     }
 }

@@ -1,0 +1,329 @@
+//! Manifold NEE to SPHERE and AREA lights through a CURVED smooth boundary (`connection =
+//! complete`; docs/manifold.md §8.2): sample a point `y` on the light by area (as `finite.rs`
+//! does for flat boundaries), seed deterministically from `(x_j, y)` and solve for `x_k` by
+//! Newton iteration ([`newton_point`]), and value the solution with the generalized geometry term
+//! `G = dω/dA⊥(y)`:
+//!
+//! ```text
+//! f_p(wi_j, ω_jk) T(d_jk) (1 − F) η² L_e(y) G |cos θ_y| tr_light / (p_sel p_A(y))
+//! ```
+//!
+//! **MIS with forward tracing and SNEE, unbiased without Bernoulli trials.** Forward tracing
+//! (phase sampling at `x_j`, refraction, the light hit) and SNEE make the same suffixes. Because
+//! the seed is a function of `(x_j, y)` only, the connection's density of ANY suffix
+//! `x_j → x_k → y` is evaluable: `p_man = p_sel p_A(y) / (G |cos θ_y|)` (solid angle of `ω_jk` at
+//! `x_j`) if Newton from `seed(x_j, y)` converges to this `ω_jk` (verified as the technique
+//! verifies it), else 0 ([`density`], "re-solve from that path's seed"). Solutions the seed misses
+//! have `p_man = 0`, and forward tracing (or SNEE) covers them with weight 1. The three-way power
+//! heuristic is `mis::env_weight`, computed from the same three densities at the three places
+//! that make such a suffix: the connection ([`sample`]), a forward path that left through the
+//! boundary right after `x_j` and hit the light ([`forward_weight`], through the stage's
+//! [`Pending`]), and SNEE's sample ([`snee_weight`]).
+
+use super::curved::{boundary_patch, SceneLocate};
+use super::finite::{self, LightPoint};
+use super::mis::{self, EnvPdfs, EnvTechnique};
+use super::newton::Failure;
+use super::newton_point::{self, PointSolution};
+use super::{add_finite, MediumVertex};
+use crate::bsdf::fresnel::fresnel;
+use crate::bsdf::{flags, BsdfSample};
+use crate::color::Spectrum;
+use crate::integrator::snee::light::light_transmission;
+use crate::integrator::snee::{passable, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
+use crate::integrator::stats::LocalStats;
+use crate::interaction::{DirectionSample, SurfaceInteraction};
+use crate::math::{Ray, Vec3};
+use crate::scene::world::{Scene, SceneEmitter};
+
+/// Probability that the connection runs at a medium vertex whose emitter sample picked an area
+/// light (a constant, part of its density everywhere): each connection costs a Newton solve
+/// (docs/manifold.md §8.2, "Cost").
+pub const RATE: f64 = 0.1;
+
+/// Two directions are the same solution when they differ by less than this (radians).
+const SAME_SOLUTION: f64 = 1e-4;
+
+/// The deterministic solve from `x_j` towards `y`, verified in the renderer's precision (the f32
+/// hit along the solution is the enclosing boundary from inside, at the solved point with the
+/// solved shading normal, and `y` lies outside both normals there). Counts the Newton work.
+fn resolve(
+    scene: &Scene,
+    x_j: &MediumVertex,
+    y: Vec3,
+    stats: &mut LocalStats,
+) -> Option<(PointSolution, SurfaceInteraction)> {
+    let mut locate = SceneLocate { scene, medium: x_j.medium, rays: 0 };
+    let r = newton_point::solve_from_seed(&mut locate, x_j.p.as_dvec3(), y.as_dvec3());
+    stats.rays += locate.rays;
+    stats.manifold_newton_solves += 1;
+    let sol = match r {
+        Ok(s) => {
+            stats.manifold_newton_iterations += s.iterations as u64;
+            s
+        }
+        Err((f, it)) => {
+            stats.manifold_newton_iterations += it as u64;
+            match f {
+                Failure::Lost => stats.manifold_newton_lost += 1,
+                Failure::NoConvergence => stats.manifold_newton_failures += 1,
+            }
+            return None;
+        }
+    };
+    let omega = sol.omega.as_vec3().normalize();
+    stats.rays += 1;
+    let si = scene.ray_intersect(&Ray::new(x_j.p, omega))?;
+    let to_y = y - si.p;
+    let ok = boundary_patch(scene, &si, x_j.medium, omega).is_some()
+        && si.n.dot(to_y) > 0.0
+        && si.sh_frame.n.dot(to_y) > 0.0
+        && (si.p.as_dvec3() - sol.refracted.x_k).length() <= 1e-3 * (1.0 + sol.refracted.t)
+        && si.sh_frame.n.as_dvec3().dot(sol.refracted.n_s) > 1.0 - 1e-4;
+    ok.then_some((sol, si))
+}
+
+/// The densities of `x_j → x_k → y` (solid angle of `ω_jk` at `x_j`): the connection's `p_man`
+/// given, forward tracing's `f_p e^{−σ_t d_jk} (1 − F)`, SNEE's (0 outside its support; with
+/// `check_support` one shadow ray `x_i → x_k`).
+#[allow(clippy::too_many_arguments)]
+fn pdfs(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    si_k: &SurfaceInteraction,
+    omega_jk: Vec3,
+    d_jk: f32,
+    light: &LightSample,
+    manifold: f64,
+    channel: usize,
+    check_support: bool,
+    stats: &mut LocalStats,
+) -> EnvPdfs {
+    let m = &scene.media[x_j.medium as usize];
+    let Some(dielectric) = (match scene.bsdf(si_k) {
+        crate::bsdf::Bsdf::Dielectric(d) => Some(d),
+        _ => None,
+    }) else {
+        return EnvPdfs::default();
+    };
+    // Fresnel about the shading normal (the normal the dielectric refracts about), from outside.
+    let f = fresnel(si_k.sh_frame.n.dot(light.omega_l), dielectric.eta).0 as f64;
+    let st = m.sigma_t[channel] as f64;
+    let forward = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp() * (1.0 - f);
+    let cos_k = omega_jk.dot(si_k.n).abs() as f64;
+    let snee =
+        mis::snee_solid_angle_pdf(scene, opts, x_i, x_j, si_k, light, channel, check_support, cos_k, d_jk, stats);
+    let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
+    EnvPdfs { manifold: finite(manifold), forward: finite(forward), snee: finite(snee) }
+}
+
+/// Does the light's front at `y` (normal `n_y`) face `x_j`? The connection solves only then (a
+/// function of `(x_j, y)`, part of its density: saves the solves towards the back half of a sphere
+/// light; the few suffixes near the silhouette it excludes are forward tracing's and SNEE's).
+#[inline]
+fn faces(n_y: Vec3, y: Vec3, x_j: Vec3) -> bool {
+    n_y.dot(x_j - y) > 0.0
+}
+
+/// The connection's density of the suffix `x_j → x_k → y` that another technique made along
+/// `omega_jk`: re-solve from the path's own seed `(x_j, y)` and keep `p_sel p_A(y) / (G |cos θ_y|)`
+/// when Newton lands on this `omega_jk`, else 0 (and 0 when [`faces`] is false). `p_y`:
+/// `p_sel p_A(y)`; `n_y`, `cos_y` at `y`.
+#[allow(clippy::too_many_arguments)]
+fn density(
+    scene: &Scene,
+    x_j: &MediumVertex,
+    omega_jk: Vec3,
+    y: Vec3,
+    n_y: Vec3,
+    p_y: f64,
+    cos_y: f32,
+    stats: &mut LocalStats,
+) -> f64 {
+    if !faces(n_y, y, x_j.p) {
+        return 0.0;
+    }
+    stats.manifold_resolves += 1;
+    match resolve(scene, x_j, y, stats) {
+        Some((sol, _)) if (sol.omega - omega_jk.as_dvec3()).length() < SAME_SOLUTION => {
+            stats.manifold_resolve_matches += 1;
+            RATE * mis::area_density(p_y, sol.g, cos_y)
+        }
+        _ => 0.0,
+    }
+}
+
+/// One verified connection: its value `f / p` (without the path throughput), its MIS weight, and
+/// the suffix (for the weights' consistency test).
+#[derive(Clone, Copy, Debug)]
+pub struct PointConnection {
+    pub value: Spectrum,
+    pub weight: f64,
+    pub si_k: SurfaceInteraction,
+    /// Unit direction `x_j → x_k`.
+    pub omega: Vec3,
+    pub light: LightSample,
+}
+
+/// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`), given that it runs
+/// (probability [`RATE`], the caller's draw): solve from the deterministic seed, verify, value
+/// (divided by [`RATE`]), and MIS-weight against forward tracing and SNEE. Counts solutions and
+/// failures.
+#[allow(clippy::too_many_arguments)]
+pub fn connect(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    lp: &LightPoint,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<PointConnection> {
+    let fail = |stats: &mut LocalStats| {
+        stats.manifold_failures += 1;
+        None
+    };
+    let (Some((n_y, uv)), SceneEmitter::Area { radiance, .. }) = (lp.area, &scene.emitters[lp.emitter as usize]) else {
+        return None;
+    };
+    if !faces(n_y, lp.y, x_j.p) {
+        return fail(stats);
+    }
+    let Some((sol, si_k)) = resolve(scene, x_j, lp.y, stats) else { return fail(stats) };
+    let to_y = lp.y - si_k.p;
+    let d_ky = to_y.length();
+    let omega_l = to_y / d_ky;
+    let cos_y = -n_y.dot(omega_l);
+    if !(cos_y > 0.0) {
+        return fail(stats); // the back of a one-sided emitter
+    }
+    let ds =
+        DirectionSample { p: lp.y, n: n_y, uv, d: omega_l, dist: d_ky, pdf: 0.0, delta: false, emitter: lp.emitter };
+    let light = LightSample::hit(omega_l, lp.y, d_ky, scene.pdf_emitter_direction(si_k.p, &ds));
+    let tr = light_transmission(scene, &si_k, &light, stats);
+    let le = radiance.eval(uv);
+    if tr == Spectrum::ZERO || le == Spectrum::ZERO {
+        return fail(stats);
+    }
+    stats.manifold_solutions += 1;
+    let m = &scene.media[x_j.medium as usize];
+    let omega = sol.omega.as_vec3().normalize();
+    let d_jk = si_k.t;
+    let eta = sol.patch.eta as f32;
+    let f = fresnel(sol.refracted.cos_out as f32, eta).0;
+    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (RATE * lp.p_y);
+    let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
+    let p_man = RATE * mis::area_density(lp.p_y, sol.g, cos_y);
+    let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
+    let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
+    Some(PointConnection { value, weight, si_k, omega, light })
+}
+
+/// The connection's weighted contribution at `x_j` (with `beta`), zero when it fails.
+#[allow(clippy::too_many_arguments)]
+pub fn sample(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    lp: &LightPoint,
+    beta: Spectrum,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Spectrum {
+    let mut result = Spectrum::ZERO;
+    if let Some(c) = connect(scene, opts, x_i, x_j, lp, channel, stats) {
+        add_finite(&mut result, beta * c.value * c.weight as f32, stats);
+    }
+    result
+}
+
+/// A forward path that left `x_j`'s curved boundary at `si_k` right after the medium vertex `x_j`
+/// (along `omega_jk`), until it hits an emitter (carried across passable surfaces only).
+#[derive(Clone, Copy, Debug)]
+pub struct Pending {
+    pub x_i: Option<SneeVertex>,
+    pub x_j: MediumVertex,
+    pub si_k: SurfaceInteraction,
+    pub omega_jk: Vec3,
+}
+
+/// After BSDF sampling at `s` (`bs` towards `wo`): a refraction out of `x_j`'s curved boundary
+/// right after `x_j` starts a [`Pending`]; a null crossing of a passable surface carries
+/// `carried`; anything else forgets it.
+pub fn pending(
+    scene: &Scene,
+    x_i: Option<SneeVertex>,
+    x_j: Option<MediumVertex>,
+    s: &SurfaceInteraction,
+    bs: &BsdfSample,
+    wo: Vec3,
+    carried: Option<Pending>,
+) -> Option<Pending> {
+    let non_null = bs.sampled_type & flags::NULL == 0;
+    if non_null && bs.sampled_type & flags::TRANSMISSION != 0 && wo.dot(s.n) > 0.0 {
+        let x_j = x_j?;
+        if !super::curved::applies(scene, x_j.medium) {
+            return None;
+        }
+        let omega_jk = s.p - x_j.p;
+        let omega_jk = omega_jk / omega_jk.length();
+        boundary_patch(scene, s, x_j.medium, omega_jk)?;
+        Some(Pending { x_i, x_j, si_k: *s, omega_jk })
+    } else if !non_null && passable(scene, s) {
+        carried
+    } else {
+        None
+    }
+}
+
+/// The weight of a forward path `p` that hit the area light at `y` (along `omega_l`): the
+/// three-way power heuristic with the connection's density evaluated by re-solving from the
+/// path's seed.
+pub fn forward_weight(
+    scene: &Scene,
+    opts: SneeOptions,
+    p: &Pending,
+    y: &SurfaceInteraction,
+    omega_l: Vec3,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<f32> {
+    scene.shapes[y.shape as usize].emitter?;
+    let (p_y, cos_y) = finite::area_point_density(scene, y, omega_l);
+    let d_jk = (p.si_k.p - p.x_j.p).length();
+    let p_man = density(scene, &p.x_j, p.omega_jk, y.p, y.n, p_y, cos_y, stats);
+    let ds = scene.direction_sample_for_hit(p.si_k.p, y);
+    let light = LightSample::hit(omega_l, y.p, ds.dist, scene.pdf_emitter_direction(p.si_k.p, &ds));
+    let pd = pdfs(scene, opts, p.x_i.as_ref(), &p.x_j, &p.si_k, p.omega_jk, d_jk, &light, p_man, channel, true, stats);
+    Some(mis::env_weight(opts, EnvTechnique::Forward, pd) as f32)
+}
+
+/// SNEE's weight for a suffix it made towards a point `light.p` of an area light through a curved
+/// boundary (the three-way weight), or `None` where the connection does not apply. No rays are
+/// counted (SNEE's sample has no statistics here).
+pub fn snee_weight(
+    scene: &Scene,
+    technique: SneeTechnique,
+    s: &SneeSuffix,
+    light: &LightSample,
+    channel: usize,
+) -> Option<f64> {
+    if light.delta || !light.dist.is_finite() || !super::curved::applies(scene, s.x_i.medium) {
+        return None;
+    }
+    let opts = SneeOptions { technique, ..scene.integrator.snee };
+    let mut no_stats = LocalStats::default();
+    let hit = finite::area_point_hit(scene, &s.si_k, light.omega_l)?;
+    let (p_y, cos_y) = finite::area_point_density(scene, &hit, light.omega_l);
+    let v_ij = s.x_j - s.x_i.p;
+    let x_j = MediumVertex { p: s.x_j, wi: -v_ij / v_ij.length(), medium: s.x_i.medium };
+    let v_jk = s.si_k.p - s.x_j;
+    let d_jk = v_jk.length();
+    let omega_jk = v_jk / d_jk;
+    let p_man = density(scene, &x_j, omega_jk, light.p, hit.n, p_y, cos_y, &mut no_stats);
+    let p = pdfs(scene, opts, Some(&s.x_i), &x_j, &s.si_k, omega_jk, d_jk, light, p_man, channel, false, &mut no_stats);
+    Some(mis::env_weight(opts, EnvTechnique::Snee, p))
+}
