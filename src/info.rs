@@ -239,6 +239,7 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         integ_json["snee_rate"] = json!(rate);
         // Which estimator runs (the paper's, or the complete one with manifold NEE).
         integ_json["connection"] = json!(integ.connection.name());
+        integ_json["reflection_chains"] = json!(integ.snee.chains);
     }
     let json = json!({
         "plugins": tree_json(&parsed.root, None),

@@ -75,7 +75,13 @@ pub fn parse(obj: &ObjectDesc) -> Result<IntegratorDesc> {
         IntegratorKind::VolpathSnee => {
             // The transport branch read `connection` before the SNEE options (same error order).
             let connection = volpath_snee::parse_connection(props)?;
-            (volpath_snee::parse_options(props)?, connection)
+            let options = volpath_snee::parse_options(props)?;
+            if options.chains && connection != manifold::Connection::Complete {
+                return Err(
+                    props.error("reflection_chains", "volpath_snee: reflection_chains needs connection = complete")
+                );
+            }
+            (options, connection)
         }
         _ => Default::default(),
     };

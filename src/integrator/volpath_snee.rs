@@ -8,6 +8,7 @@
 //! | `snee`       | string  | `mis` (default): SNEE and forward tracing by MIS; `snee`: SNEE alone where it applies; `forward`: forward alone (= volpath) |
 //! | `transport`  | string  | `all` (default); `snee`: only paths whose last two scattering vertices before leaving through the boundary are medium vertices, in SNEE's support (the paper's Figure 3) |
 //! | `connection` | string  | `paper` (default): the paper's estimator; `complete`: also manifold NEE through flat smooth boundaries (`manifold/`, docs/manifold.md) |
+//! | `reflection_chains` | boolean | with `connection = complete`: also connect through an internal reflection then a refraction (two-vertex chains, `manifold/chain.rs`, docs/manifold.md §9) under a directional light; default `false` (its cost exceeds its gain on the paper's statue) |
 //! | `snee_rate`  | float   | probability `r` of running SNEE at a scattering vertex (default: chosen per medium from its boundary and the lights, see [`snee::auto_rate`]); MIS counts SNEE's density as `r · pdf_snee`, so any `r` is unbiased |
 //!
 //! ```xml
@@ -68,7 +69,8 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
             )
         }
     };
-    Ok(SneeOptions { technique, transport, rate })
+    let chains = props.bool("reflection_chains", false)?;
+    Ok(SneeOptions { technique, transport, rate, chains })
 }
 
 /// The `connection` parameter (manifold NEE, `integrator/manifold/`).

@@ -53,3 +53,29 @@ fn info_and_stats_say_which_estimator_ran() {
         }
     }
 }
+
+/// A glass sphere (a curved boundary) of a medium under a directional light, with
+/// `reflection_chains` set.
+fn chain_scene(connection: &str, chains: bool) -> Result<snee::scene::world::Scene, snee::scene::Error> {
+    let xml = xml(connection)
+        .replace(
+            r#"<string name="connection""#,
+            &format!("<boolean name=\"reflection_chains\" value=\"{chains}\"/>\n    <string name=\"connection\""),
+        )
+        .replace(r#"<shape type="cube">"#, r#"<shape type="sphere">"#);
+    build_scene(&parse_str(&xml, "c.xml", Path::new("."), &[])?)
+}
+
+#[test]
+fn reflection_chains_run_only_when_asked_and_need_complete() {
+    let e = chain_scene("paper", true).err().expect("an error");
+    let msg = e.to_string();
+    assert!(msg.starts_with("c.xml:3:") && msg.contains("reflection_chains needs connection = complete"), "{msg}");
+    for chains in [false, true] {
+        let scene = chain_scene("complete", chains).unwrap();
+        let opts = RenderOptions { spp: Some(16), seed: 1, time_budget: None, progress: false };
+        let json = render(&scene, &opts, &AtomicBool::new(false)).stats.to_json();
+        assert!(json["manifold_attempts"].as_u64().unwrap() > 0, "{json}");
+        assert_eq!(json["chain_attempts"].as_u64().unwrap() > 0, chains, "{json}");
+    }
+}

@@ -18,10 +18,12 @@
 //! forward technique can make (a delta light behind a delta interface) and shares V–V–S_t–L
 //! suffixes with SNEE; under an environment or an area light it also shares them with forward
 //! tracing ([`mis`]). Lights at a finite distance: [`finite`]. Scope (docs/manifold.md §6):
-//! boundaries made of flat facets ([`flat`]; flat ROUGH facets under a directional light or an
-//! environment: [`rough`], §7); curved smooth boundaries under a directional light ([`curved`],
-//! Newton and specular manifold sampling in [`newton`], §8); elsewhere it draws no samples and
-//! `volpath_snee` is the paper's estimator.
+//! boundaries made of flat facets ([`flat`]); ROUGH boundaries, flat or curved, under a
+//! directional light or an environment ([`rough`], §7); curved smooth boundaries under a
+//! directional light ([`curved`], Newton and specular manifold sampling in [`newton`], §8) and
+//! under area and sphere lights ([`curved_finite`], [`newton_point`], §8.2); with
+//! `reflection_chains`, two-vertex chains under a directional light ([`chain`], §9); elsewhere
+//! it draws no samples and `volpath_snee` is the paper's estimator.
 //!
 //! The interface the volpath loop uses: a [`ManifoldStage`] per path next to SNEE's
 //! (`stage.rs`: [`sample`] at a medium vertex, the [`Tracker`] at surfaces, [`forward_weight`] for
@@ -188,8 +190,10 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
     let (beta, depth, max_depth) = (v.beta, v.depth, v.max_depth);
     let Some(boundary) = boundary_of(scene, x_j.medium) else {
-        // Curved boundary: one refraction, then the two-vertex chain (reflection, refraction).
-        return curved::sample(cx, opts, x_i, v).map(|r| r + chain::sample(cx, opts, v));
+        // Curved boundary: one refraction, and with `reflection_chains` the two-vertex chain
+        // (reflection, refraction).
+        let one = curved::sample(cx, opts, x_i, v);
+        return if opts.chains { one.map(|r| r + chain::sample(cx, opts, v)) } else { one };
     };
     let u: Vec2 = sampler.next_2d();
     // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).

@@ -23,11 +23,14 @@ pub struct SneeOptions {
     pub transport: SneeTransport,
     /// `snee_rate`; `None`: [`auto_rate`] per medium.
     pub rate: Option<f32>,
+    /// `reflection_chains` (with `connection = complete`): also the two-vertex chains (internal
+    /// reflection, then refraction) of `manifold/chain.rs` under a directional light.
+    pub chains: bool,
 }
 
 impl Default for SneeOptions {
     fn default() -> Self {
-        SneeOptions { technique: SneeTechnique::Mis, transport: SneeTransport::All, rate: None }
+        SneeOptions { technique: SneeTechnique::Mis, transport: SneeTransport::All, rate: None, chains: false }
     }
 }
 
