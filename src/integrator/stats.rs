@@ -61,7 +61,7 @@ pub struct LocalStats {
     pub chain_iterations: u64,
     /// Chains found and verified (both boundary points, the light segment).
     pub chain_solutions: u64,
-    /// The chain's Bernoulli trials stopped at the cap (`chain::MAX_TRIALS`).
+    /// The chain's Bernoulli trials stopped at the cap (`newton::MAX_TRIALS`, as for the one-refraction connection).
     pub chain_trials_capped: u64,
     /// Re-solves from a path's own seed to evaluate the curved finite-light connection's density
     /// for a suffix forward tracing or SNEE made (`curved_finite.rs`), and those that found it.

@@ -29,7 +29,7 @@
 //! probability; no deterministic seed is known for a reflection point), Bernoulli trials capped at
 //! [`MAX_TRIALS`] (capped connections counted in `--stats` as `chain_trials_capped`).
 
-use super::newton::{tangents, Failure, Patch, Refracted};
+use super::newton::{bernoulli_trials, damped_step, moved, tangents, Failure, Patch, Refracted};
 use super::MediumVertex;
 use crate::bsdf::fresnel::fresnel;
 use crate::color::Spectrum;
@@ -45,14 +45,10 @@ use crate::scene::world::Scene;
 pub const MAX_ITERATIONS: u32 = 32;
 /// Converged when `|o − omega_l| < TOLERANCE` (f64, radians).
 pub const TOLERANCE: f64 = 1e-8;
-/// Largest step (radians) per Newton iteration.
-const MAX_STEP: f64 = 0.25;
 /// Finite-difference step for the Jacobian (radians).
 const FD_STEP: f64 = 1e-6;
-/// Largest number of Bernoulli trials (SMS's cap; beyond it `1/p` is truncated).
-pub const MAX_TRIALS: u32 = 64;
-/// Two solutions are the same when their directions differ by less than this (radians).
-const SAME_SOLUTION: f64 = 1e-4;
+/// Largest number of Bernoulli trials (SMS's cap, shared with the one-refraction connection).
+pub use super::newton::MAX_TRIALS;
 
 /// Where the chain's rays meet the boundary (the caller's ray casts).
 pub trait ChainLocate {
@@ -93,12 +89,6 @@ pub fn chain_map(p1: &Patch, p2: &Patch, x_j: DVec3, omega: DVec3) -> Option<Cha
     let mut out = p2.refract(x_1 + d_12 * nudge, d_12)?;
     out.t += nudge;
     Some(ChainMap { x_1, n_1, cos_1, t_1, d_12, out })
-}
-
-/// `omega` moved by `(a, b)` in its tangent coordinates.
-#[inline]
-fn moved(omega: DVec3, t: (DVec3, DVec3), a: f64, b: f64) -> DVec3 {
-    (omega + t.0 * a + t.1 * b).normalize()
 }
 
 #[inline]
@@ -180,30 +170,13 @@ pub fn solve(
             break;
         }
         let r = residual(&c, l, omega_l);
-        let mut da = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
-        let mut db = -(-j[1][0] * r[0] + j[0][0] * r[1]) / det;
-        let len = da.hypot(db);
-        if len > MAX_STEP {
-            da *= MAX_STEP / len;
-            db *= MAX_STEP / len;
-        }
-        let t = tangents(omega);
-        let mut accepted = false;
-        for _ in 0..10 {
-            let cand = moved(omega, t, da, db);
-            if let Some((q1, q2, cc)) = locate_chain(locate, x_j, cand) {
-                if (cc.out.o - omega_l).length() < norm {
-                    (omega, p1, p2, c) = (cand, q1, q2, cc);
-                    accepted = true;
-                    break;
-                }
-            }
-            da *= 0.5;
-            db *= 0.5;
-        }
-        if !accepted {
+        let step = damped_step(omega, j, r, det, |cand| {
+            locate_chain(locate, x_j, cand).filter(|(_, _, cc)| (cc.out.o - omega_l).length() < norm)
+        });
+        let Some((cand, (q1, q2, cc))) = step else {
             return Err((Failure::NoConvergence, it + 1));
-        }
+        };
+        (omega, p1, p2, c) = (cand, q1, q2, cc);
     }
     Err((Failure::NoConvergence, MAX_ITERATIONS))
 }
@@ -250,17 +223,8 @@ pub fn sample_solution(
         r.ok()
     };
     let s = draw(locate, u, counts)?;
-    let mut n = 1;
-    loop {
-        if n >= MAX_TRIALS {
-            counts.capped += 1;
-            break;
-        }
-        match draw(locate, u, counts) {
-            Some(t) if (t.omega - s.omega).length() < SAME_SOLUTION => break,
-            _ => n += 1,
-        }
-    }
+    let (n, capped) = bernoulli_trials(s.omega, || draw(locate, u, counts).map(|t| t.omega));
+    counts.capped += capped as u64;
     Some((s, n))
 }
 

@@ -145,8 +145,54 @@ pub fn tangents(n: DVec3) -> (DVec3, DVec3) {
 
 /// `omega` moved by `(a, b)` in its tangent coordinates.
 #[inline]
-fn moved(omega: DVec3, t: (DVec3, DVec3), a: f64, b: f64) -> DVec3 {
+pub fn moved(omega: DVec3, t: (DVec3, DVec3), a: f64, b: f64) -> DVec3 {
     (omega + t.0 * a + t.1 * b).normalize()
+}
+
+/// The damped Newton step of every solver here (`solve`, `newton_point`, `chain`): the step
+/// `δ = −J⁻¹ C` (Jacobian `j` with determinant `det`, residual `c`) in `omega`'s tangent
+/// coordinates, capped at `MAX_STEP` and halved (at most 10 times) until `accept` takes the moved
+/// direction; `None` when it never does.
+pub fn damped_step<T>(
+    omega: DVec3,
+    j: [[f64; 2]; 2],
+    c: [f64; 2],
+    det: f64,
+    mut accept: impl FnMut(DVec3) -> Option<T>,
+) -> Option<(DVec3, T)> {
+    let mut da = -(j[1][1] * c[0] - j[0][1] * c[1]) / det;
+    let mut db = -(-j[1][0] * c[0] + j[0][0] * c[1]) / det;
+    let len = da.hypot(db);
+    if len > MAX_STEP {
+        da *= MAX_STEP / len;
+        db *= MAX_STEP / len;
+    }
+    let t = tangents(omega);
+    for _ in 0..10 {
+        let cand = moved(omega, t, da, db);
+        if let Some(v) = accept(cand) {
+            return Some((cand, v));
+        }
+        da *= 0.5;
+        db *= 0.5;
+    }
+    None
+}
+
+/// Specular manifold sampling's Bernoulli trials (Zeltner et al. 2020, §4.3) after a first solution
+/// `omega`: draw solutions until one equal to it comes back. The number of draws `n` (counting the
+/// first) has `E[n] = 1/p`; returns `(n, capped)`, `capped` when [`MAX_TRIALS`] stopped it.
+pub fn bernoulli_trials(omega: DVec3, mut draw: impl FnMut() -> Option<DVec3>) -> (u32, bool) {
+    let mut n = 1;
+    loop {
+        if n >= MAX_TRIALS {
+            return (n, true);
+        }
+        match draw() {
+            Some(o) if (o - omega).length() < SAME_SOLUTION => return (n, false),
+            _ => n += 1,
+        }
+    }
 }
 
 /// The constraint `C = P_l (o − omega_l)` in the tangent coordinates `l` of `omega_l`.
@@ -237,34 +283,16 @@ pub fn solve(locate: &mut impl Locate, x_j: DVec3, omega_l: DVec3, seed: DVec3) 
         if it == MAX_ITERATIONS || !(det.abs() > 1e-300) {
             break;
         }
-        // δ = −J⁻¹ C.
-        let mut da = -(j[1][1] * c[0] - j[0][1] * c[1]) / det;
-        let mut db = -(-j[1][0] * c[0] + j[0][0] * c[1]) / det;
-        let len = da.hypot(db);
-        if len > MAX_STEP {
-            da *= MAX_STEP / len;
-            db *= MAX_STEP / len;
-        }
-        let t = tangents(omega);
-        let mut accepted = false;
-        for _ in 0..10 {
-            let cand = moved(omega, t, da, db);
-            if let Some(p) = locate.locate(x_j, cand) {
-                if let Some(rc) = p.refract(x_j, cand) {
-                    let cc = residual(&rc, omega_l, l);
-                    if (rc.o - omega_l).length() < norm {
-                        (omega, patch, r, c) = (cand, p, rc, cc);
-                        accepted = true;
-                        break;
-                    }
-                }
-            }
-            da *= 0.5;
-            db *= 0.5;
-        }
-        if !accepted {
+        let step = damped_step(omega, j, c, det, |cand| {
+            let p = locate.locate(x_j, cand)?;
+            let rc = p.refract(x_j, cand)?;
+            ((rc.o - omega_l).length() < norm).then_some((p, rc))
+        });
+        let Some((cand, (p, rc))) = step else {
             return Err((Failure::NoConvergence, it + 1));
-        }
+        };
+        c = residual(&rc, omega_l, l);
+        (omega, patch, r) = (cand, p, rc);
     }
     Err((Failure::NoConvergence, MAX_ITERATIONS))
 }
@@ -347,27 +375,18 @@ pub fn sample_solution(
         }
     };
     let s = draw(locate, u, counts)?;
-    let mut n = 1;
-    loop {
-        if n >= MAX_TRIALS {
-            counts.capped += 1;
-            break;
-        }
-        match draw(locate, u, counts) {
-            Some(t) if (t.omega - s.omega).length() < SAME_SOLUTION => break,
-            _ => n += 1,
-        }
-    }
+    let (n, capped) = bernoulli_trials(s.omega, || draw(locate, u, counts).map(|t| t.omega));
+    counts.capped += capped as u64;
     Some((s, n))
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     /// The whole boundary is one analytic sphere (unit radius at the origin).
-    struct Ball {
-        eta: f64,
+    pub(in super::super) struct Ball {
+        pub(in super::super) eta: f64,
     }
 
     impl Locate for Ball {
@@ -378,8 +397,8 @@ mod tests {
 
     /// A smooth-shaded "bump": one large triangle whose vertex normals tilt outwards, so the
     /// shading normal varies linearly across a flat facet (curvature from the normals alone).
-    struct Bump {
-        eta: f64,
+    pub(in super::super) struct Bump {
+        pub(in super::super) eta: f64,
     }
 
     impl Locate for Bump {

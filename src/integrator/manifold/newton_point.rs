@@ -27,13 +27,11 @@
 //! direction `y − x_k⁰` into the medium there and reverse it. A function of `(x_j, y)` only, so the
 //! technique's density of a given suffix can be evaluated by re-solving from that seed.
 
-use super::newton::{tangents, Failure, Locate, Patch, Refracted, MAX_ITERATIONS};
+use super::newton::{damped_step, moved, tangents, Failure, Locate, Patch, Refracted, MAX_ITERATIONS};
 use crate::math::DVec3;
 
 /// Converged when `|Φ − y| < TOLERANCE · |y − x_j|`.
 pub const TOLERANCE: f64 = 1e-10;
-/// Largest step (radians) per Newton iteration.
-const MAX_STEP: f64 = 0.25;
 /// Finite-difference step (radians) for the Jacobian.
 const FD_STEP: f64 = 1e-6;
 
@@ -48,12 +46,6 @@ pub struct PointSolution {
     /// perpendicular to the outgoing ray).
     pub g: f64,
     pub iterations: u32,
-}
-
-/// `omega` moved by `(a, b)` in its tangent coordinates.
-#[inline]
-fn moved(omega: DVec3, t: (DVec3, DVec3), a: f64, b: f64) -> DVec3 {
-    (omega + t.0 * a + t.1 * b).normalize()
 }
 
 /// The refraction at `omega` and where the refracted ray meets the plane through `y`
@@ -152,33 +144,15 @@ pub fn solve_point(
         if !(det.abs() > 1e-300) || !det.is_finite() {
             break;
         }
-        // δ = −J⁻¹ C.
-        let mut da = -(j[1][1] * c[0] - j[0][1] * c[1]) / det;
-        let mut db = -(-j[1][0] * c[0] + j[0][0] * c[1]) / det;
-        let len = da.hypot(db);
-        if len > MAX_STEP {
-            da *= MAX_STEP / len;
-            db *= MAX_STEP / len;
-        }
-        let t = tangents(omega);
-        let mut accepted = false;
-        for _ in 0..10 {
-            let cand = moved(omega, t, da, db);
-            if let Some(pc) = locate.locate(x_j, cand) {
-                if let Some((rc, qc)) = beam(&pc, x_j, cand, y, l) {
-                    if (qc - y).length() < norm {
-                        (omega, patch, r, p) = (cand, pc, rc, qc);
-                        accepted = true;
-                        break;
-                    }
-                }
-            }
-            da *= 0.5;
-            db *= 0.5;
-        }
-        if !accepted {
+        let step = damped_step(omega, j, c, det, |cand| {
+            let pc = locate.locate(x_j, cand)?;
+            let (rc, qc) = beam(&pc, x_j, cand, y, l)?;
+            ((qc - y).length() < norm).then_some((pc, rc, qc))
+        });
+        let Some((cand, (pc, rc, qc))) = step else {
             return Err((Failure::NoConvergence, it + 1));
-        }
+        };
+        (omega, patch, r, p) = (cand, pc, rc, qc);
     }
     Err((Failure::NoConvergence, MAX_ITERATIONS))
 }
@@ -192,33 +166,9 @@ pub fn solve_from_seed(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> Result
 
 #[cfg(test)]
 mod tests {
+    use super::super::newton::tests::{Ball, Bump};
     use super::super::newton::Surface;
     use super::*;
-
-    struct Ball {
-        eta: f64,
-    }
-    impl Locate for Ball {
-        fn locate(&mut self, _o: DVec3, _d: DVec3) -> Option<Patch> {
-            Some(Patch { surface: Surface::Sphere { center: DVec3::ZERO, radius: 1.0, outward: 1.0 }, eta: self.eta })
-        }
-    }
-
-    /// One large triangle whose vertex normals tilt outwards (curvature from the normals alone).
-    struct Bump {
-        eta: f64,
-    }
-    impl Locate for Bump {
-        fn locate(&mut self, _o: DVec3, _d: DVec3) -> Option<Patch> {
-            let p = [DVec3::new(-3.0, -3.0, 1.0), DVec3::new(3.0, -3.0, 1.0), DVec3::new(0.0, 3.0, 1.0)];
-            let n = [
-                DVec3::new(-0.4, -0.3, 1.0).normalize(),
-                DVec3::new(0.5, -0.2, 1.0).normalize(),
-                DVec3::new(0.1, 0.6, 1.0).normalize(),
-            ];
-            Some(Patch { surface: Surface::Triangle { p, n }, eta: self.eta })
-        }
-    }
 
     /// A flat facet (constant normal +z at height 1).
     struct Flat {
