@@ -248,7 +248,7 @@ impl ChainLocate for SceneChain<'_> {
         self.rays += 1;
         let d = d.as_vec3().normalize();
         let si = self.scene.ray_intersect(&Ray::new(x_j.as_vec3(), d))?;
-        let patch = super::curved::boundary_patch(self.scene, &si, self.medium, d)?;
+        let patch = super::locate::boundary_patch(self.scene, &si, self.medium, d)?;
         Some((patch, si.n.as_dvec3()))
     }
 
@@ -257,7 +257,7 @@ impl ChainLocate for SceneChain<'_> {
         let d = d.as_vec3().normalize();
         let o = offset_origin(x_1.as_vec3(), n_1.as_vec3(), d);
         let si = self.scene.ray_intersect(&Ray::new(o, d))?;
-        super::curved::boundary_patch(self.scene, &si, self.medium, d)
+        super::locate::boundary_patch(self.scene, &si, self.medium, d)
     }
 }
 
@@ -290,7 +290,7 @@ pub fn connect(
     let omega = sol.omega.as_vec3().normalize();
     stats.rays += 2;
     let si_1 = scene.ray_intersect(&Ray::new(x_j.p, omega)).filter(|si| {
-        super::curved::boundary_patch(scene, si, x_j.medium, omega).is_some()
+        super::locate::boundary_patch(scene, si, x_j.medium, omega).is_some()
             && agrees(si, sol.map.x_1, sol.map.n_1, sol.map.t_1)
     })?;
     let d_12 = sol.map.d_12.as_vec3().normalize();
@@ -298,7 +298,7 @@ pub fn connect(
         return None;
     }
     let si_2 = scene.ray_intersect(&Ray::new(offset_origin(si_1.p, si_1.n, d_12), d_12)).filter(|si| {
-        super::curved::boundary_patch(scene, si, x_j.medium, d_12).is_some()
+        super::locate::boundary_patch(scene, si, x_j.medium, d_12).is_some()
             && si.n.dot(omega_l) > 0.0
             && si.sh_frame.n.dot(omega_l) > 0.0
             && agrees(si, sol.map.out.x_k, sol.map.out.n_s, sol.map.out.t)
@@ -325,7 +325,7 @@ pub fn connect(
 /// `transport = snee`). Draws one 2-D sample and the seeds whenever it runs.
 pub fn sample(cx: &mut Cx, opts: SneeOptions, v: &Scatter) -> Spectrum {
     let (scene, sampler, stats) = (cx.scene, &mut *cx.sampler, &mut *cx.stats);
-    if !super::curved::applies(scene, v.medium) {
+    if !super::locate::applies(scene, v.medium) {
         return Spectrum::ZERO;
     }
     let u: Vec2 = sampler.next_2d();

@@ -28,7 +28,8 @@
 //! measured in the tests (docs/manifold.md §8). Environments, area and point lights through a
 //! curved boundary are not connected (weight 0 here: the other techniques' weights stand).
 
-use super::newton::{self, Locate, Patch, Surface};
+use super::locate::{applies, boundary_patch, SceneLocate};
+use super::newton;
 use super::{verified_light_segment, MediumVertex};
 use crate::bsdf::fresnel::fresnel;
 use crate::bsdf::Bsdf;
@@ -38,7 +39,7 @@ use crate::integrator::cx::{Cx, Scatter};
 use crate::integrator::snee::{self, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
-use crate::math::{DVec3, Ray, Vec2, Vec3};
+use crate::math::{Ray, Vec2, Vec3};
 use crate::sampler::Sampler;
 use crate::scene::world::{Scene, SceneEmitter};
 use crate::shape::Geometry;
@@ -75,56 +76,6 @@ fn curved_boundary(scene: &Scene, medium: u32) -> bool {
         }
     }
     enclosed
-}
-
-/// Does the curved connection run for `medium`?
-#[inline]
-pub fn applies(scene: &Scene, medium: u32) -> bool {
-    super::tables(scene).and_then(|t| t.curved.get(medium as usize).copied()).unwrap_or(false)
-}
-
-/// The scene as the Newton walk sees it: each step's ray cast from `x_j`, accepted when the first
-/// hit is `medium`'s enclosing smooth dielectric, met from inside.
-pub(super) struct SceneLocate<'a> {
-    pub(super) scene: &'a Scene,
-    pub(super) medium: u32,
-    pub(super) rays: u64,
-}
-
-impl Locate for SceneLocate<'_> {
-    fn locate(&mut self, o: DVec3, d: DVec3) -> Option<Patch> {
-        self.rays += 1;
-        let si = self.scene.ray_intersect(&Ray::new(o.as_vec3(), d.as_vec3().normalize()))?;
-        boundary_patch(self.scene, &si, self.medium, d.as_vec3())
-    }
-}
-
-/// The closed-form patch of the boundary hit `si` (reached from inside `medium` along `d`).
-pub(super) fn boundary_patch(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3) -> Option<Patch> {
-    let s = &scene.shapes[si.shape as usize];
-    if s.interior != Some(medium) || s.exterior.is_some() || !(d.dot(si.n) > 0.0) {
-        return None;
-    }
-    let Bsdf::Dielectric(b) = scene.bsdf(si) else { return None };
-    let surface = match &s.geometry {
-        Geometry::Mesh(mesh) => {
-            let p = mesh.vertices(si.prim).map(|v| v.as_dvec3());
-            let sign = if mesh.flip_normals { -1.0 } else { 1.0 };
-            let n = if mesh.normals.is_empty() {
-                [si.n.as_dvec3(); 3]
-            } else {
-                mesh.indices[si.prim as usize].map(|i| mesh.normals[i as usize].as_dvec3() * sign)
-            };
-            Surface::Triangle { p, n }
-        }
-        Geometry::Sphere(sp) => Surface::Sphere {
-            center: sp.center.as_dvec3(),
-            radius: sp.radius as f64,
-            outward: if sp.flip_normals { -1.0 } else { 1.0 },
-        },
-        _ => return None,
-    };
-    Some(Patch { surface, eta: b.eta as f64 })
 }
 
 /// A verified connection: its value (without the path throughput and the MIS weight) and `x_k`.

@@ -20,8 +20,8 @@
 //! boundary right after `x_j` and hit the light ([`forward_weight`], through the stage's
 //! [`Pending`]), and SNEE's sample ([`snee_weight`]).
 
-use super::curved::{boundary_patch, SceneLocate};
 use super::finite::{self, LightPoint};
+use super::locate::{boundary_patch, SceneLocate};
 use super::mis::{self, EnvPdfs, EnvTechnique};
 use super::newton::Failure;
 use super::newton_point::{self, PointSolution};
@@ -265,7 +265,7 @@ pub fn pending(
     let non_null = bs.sampled_type & flags::NULL == 0;
     if non_null && bs.sampled_type & flags::TRANSMISSION != 0 && wo.dot(s.n) > 0.0 {
         let x_j = x_j?;
-        if !super::curved::applies(scene, x_j.medium) {
+        if !super::locate::applies(scene, x_j.medium) {
             return None;
         }
         let omega_jk = s.p - x_j.p;
@@ -311,7 +311,7 @@ pub fn snee_weight(
     light: &LightSample,
     channel: usize,
 ) -> Option<f64> {
-    if light.delta || !light.dist.is_finite() || !super::curved::applies(scene, s.x_i.medium) {
+    if light.delta || !light.dist.is_finite() || !super::locate::applies(scene, s.x_i.medium) {
         return None;
     }
     let opts = SneeOptions { technique, ..scene.integrator.snee };

@@ -36,6 +36,7 @@ pub mod curved;
 pub mod curved_finite;
 pub mod finite;
 pub mod flat;
+pub mod locate;
 pub mod mis;
 pub mod newton;
 pub mod newton_point;
