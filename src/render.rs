@@ -59,58 +59,34 @@ pub struct RenderStats {
     /// Samples per pixel completed (all pixels).
     pub spp: u32,
     pub samples: u64,
-    pub rays: u64,
-    pub rejected_samples: u64,
-    pub snee_attempts: u64,
-    pub snee_probe_failures: u64,
     /// Which `volpath_snee` estimator ran (`paper`, `complete`; empty for other integrators).
     pub connection: &'static str,
-    pub manifold_attempts: u64,
-    pub manifold_solutions: u64,
-    pub manifold_failures: u64,
-    pub manifold_newton_solves: u64,
-    pub manifold_newton_iterations: u64,
-    pub manifold_newton_failures: u64,
-    pub manifold_newton_lost: u64,
-    pub manifold_trials_capped: u64,
-    pub chain_attempts: u64,
-    pub chain_solves: u64,
-    pub chain_iterations: u64,
-    pub chain_solutions: u64,
-    pub chain_trials_capped: u64,
-    pub manifold_resolves: u64,
-    pub manifold_resolve_matches: u64,
+    /// Rays, rejected samples, SNEE and manifold counters (`integrator/stats.rs`), read as fields
+    /// of `RenderStats` through `Deref`.
+    pub counters: LocalStats,
 }
 
 impl RenderStats {
     pub fn to_json(&self) -> serde_json::Value {
-        serde_json::json!({
+        let mut json = serde_json::json!({
             "seconds": self.seconds,
             "spp": self.spp,
             "samples": self.samples,
             "samples_per_second": self.samples as f64 / self.seconds.max(1e-9),
-            "rays": self.rays,
             "rays_per_second": self.rays as f64 / self.seconds.max(1e-9),
-            "rejected_samples": self.rejected_samples,
-            "snee_attempts": self.snee_attempts,
-            "snee_probe_failures": self.snee_probe_failures,
             "connection": self.connection,
-            "manifold_attempts": self.manifold_attempts,
-            "manifold_solutions": self.manifold_solutions,
-            "manifold_failures": self.manifold_failures,
-            "manifold_newton_solves": self.manifold_newton_solves,
-            "manifold_newton_iterations": self.manifold_newton_iterations,
-            "manifold_newton_failures": self.manifold_newton_failures,
-            "manifold_newton_lost": self.manifold_newton_lost,
-            "manifold_trials_capped": self.manifold_trials_capped,
-            "chain_attempts": self.chain_attempts,
-            "chain_solves": self.chain_solves,
-            "chain_iterations": self.chain_iterations,
-            "chain_solutions": self.chain_solutions,
-            "chain_trials_capped": self.chain_trials_capped,
-            "manifold_resolves": self.manifold_resolves,
-            "manifold_resolve_matches": self.manifold_resolve_matches,
-        })
+        });
+        for (name, value) in self.counters.named() {
+            json[name] = serde_json::json!(value);
+        }
+        json
+    }
+}
+
+impl std::ops::Deref for RenderStats {
+    type Target = LocalStats;
+    fn deref(&self) -> &LocalStats {
+        &self.counters
     }
 }
 
@@ -441,30 +417,12 @@ pub fn render_range(
             seconds,
             spp: next - start_sample,
             samples: samples_done,
-            rays: stats.rays.load(Ordering::Relaxed),
-            rejected_samples: stats.rejected_samples.load(Ordering::Relaxed),
-            snee_attempts: stats.snee_attempts.load(Ordering::Relaxed),
-            snee_probe_failures: stats.snee_probe_failures.load(Ordering::Relaxed),
             connection: if scene.integrator.kind == IntegratorKind::VolpathSnee {
                 scene.integrator.connection.name()
             } else {
                 ""
             },
-            manifold_attempts: stats.manifold_attempts.load(Ordering::Relaxed),
-            manifold_solutions: stats.manifold_solutions.load(Ordering::Relaxed),
-            manifold_failures: stats.manifold_failures.load(Ordering::Relaxed),
-            manifold_newton_solves: stats.manifold_newton_solves.load(Ordering::Relaxed),
-            manifold_newton_iterations: stats.manifold_newton_iterations.load(Ordering::Relaxed),
-            manifold_newton_failures: stats.manifold_newton_failures.load(Ordering::Relaxed),
-            manifold_newton_lost: stats.manifold_newton_lost.load(Ordering::Relaxed),
-            manifold_trials_capped: stats.manifold_trials_capped.load(Ordering::Relaxed),
-            chain_attempts: stats.chain_attempts.load(Ordering::Relaxed),
-            chain_solves: stats.chain_solves.load(Ordering::Relaxed),
-            chain_iterations: stats.chain_iterations.load(Ordering::Relaxed),
-            chain_solutions: stats.chain_solutions.load(Ordering::Relaxed),
-            chain_trials_capped: stats.chain_trials_capped.load(Ordering::Relaxed),
-            manifold_resolves: stats.manifold_resolves.load(Ordering::Relaxed),
-            manifold_resolve_matches: stats.manifold_resolve_matches.load(Ordering::Relaxed),
+            counters: stats.snapshot(),
         },
     }
 }
