@@ -36,9 +36,9 @@ use crate::bsdf::Bsdf;
 use crate::color::Spectrum;
 use crate::emitter::Emitter;
 use crate::integrator::cx::{Cx, Scatter};
-use crate::integrator::snee::{self, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
+use crate::integrator::snee::{LightSample, SneeOptions, SneeVertex};
 use crate::integrator::stats::LocalStats;
-use crate::interaction::{offset_origin, spawn_ray_between, SurfaceInteraction};
+use crate::interaction::SurfaceInteraction;
 use crate::math::{Ray, Vec2, Vec3};
 use crate::sampler::Sampler;
 use crate::scene::world::{Scene, SceneEmitter};
@@ -137,32 +137,6 @@ pub fn connect(
     Some(CurvedConnection { value, si_k, omega })
 }
 
-/// Is the suffix `x_i → x_j → x_k → light` in SNEE's support (SNEE's density positive)? The
-/// partition of this file's MIS: such suffixes are SNEE's alone.
-#[allow(clippy::too_many_arguments)]
-fn in_snee_support(
-    scene: &Scene,
-    opts: SneeOptions,
-    x_i: Option<&SneeVertex>,
-    x_j: &MediumVertex,
-    si_k: &SurfaceInteraction,
-    light: &LightSample,
-    channel: usize,
-    stats: &mut LocalStats,
-) -> bool {
-    let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) else {
-        return false;
-    };
-    let Some(tables) = super::tables(scene) else { return false };
-    let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
-    if !(snee::pdf_snee(scene, tables, &suffix, light, channel) > 0.0) {
-        return false;
-    }
-    stats.rays += 1;
-    let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
-    !scene.ray_test(&spawn_ray_between(x_i.p, inner_k))
-}
-
 /// The curved connection at a real scatter `v` (`x_j = v.p`), or `None` where it does not run
 /// (then the caller's flat connection did not run either). Draws one 2-D sample when it runs.
 pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scatter) -> Option<Spectrum> {
@@ -194,7 +168,9 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     }
     let Some(c) = connect(scene, &x_j, ds.d, weight, sampler, stats) else { return Some(Spectrum::ZERO) };
     let light = LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: true, le: Spectrum::ZERO };
-    if !opts.keeps_all() || in_snee_support(scene, opts, x_i, &x_j, &c.si_k, &light, channel, stats) {
+    if !opts.keeps_all()
+        || super::mis::snee_suffix_pdf(scene, opts, x_i, &x_j, &c.si_k, &light, channel, true, stats).is_some()
+    {
         return Some(Spectrum::ZERO);
     }
     let mut result = Spectrum::ZERO;

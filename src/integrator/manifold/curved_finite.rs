@@ -101,7 +101,6 @@ fn pdfs(
     check_support: bool,
     stats: &mut LocalStats,
 ) -> EnvPdfs {
-    let m = &scene.media[x_j.medium as usize];
     let Some(dielectric) = (match scene.bsdf(si_k) {
         crate::bsdf::Bsdf::Dielectric(d) => Some(d),
         _ => None,
@@ -110,13 +109,22 @@ fn pdfs(
     };
     // Fresnel about the shading normal (the normal the dielectric refracts about), from outside.
     let f = fresnel(si_k.sh_frame.n.dot(light.omega_l), dielectric.eta).0 as f64;
-    let st = m.sigma_t[channel] as f64;
-    let forward = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp() * (1.0 - f);
     let cos_k = omega_jk.dot(si_k.n).abs() as f64;
-    let snee =
-        mis::snee_solid_angle_pdf(scene, opts, x_i, x_j, si_k, light, channel, check_support, cos_k, d_jk, stats);
-    let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
-    EnvPdfs { manifold: finite(manifold), forward: finite(forward), snee: finite(snee) }
+    mis::pdfs_at(
+        scene,
+        opts,
+        x_i,
+        x_j,
+        si_k,
+        omega_jk,
+        d_jk,
+        (f, cos_k),
+        light,
+        manifold,
+        channel,
+        check_support,
+        stats,
+    )
 }
 
 /// Does the light's front at `y` (normal `n_y`) face `x_j`? The connection solves only then (a

@@ -82,23 +82,76 @@ pub fn suffix_pdfs(
     check_support: bool,
     stats: &mut LocalStats,
 ) -> EnvPdfs {
-    let m = &scene.media[x_j.medium as usize];
     let v = si_k.p - x_j.p;
     let d_jk = v.length();
-    let omega_jk = v / d_jk;
+    let refraction = (r.fresnel as f64, r.cos_in as f64);
+    pdfs_at(scene, opts, x_i, x_j, si_k, v / d_jk, d_jk, refraction, light, manifold, channel, check_support, stats)
+}
+
+/// [`suffix_pdfs`] for any smooth boundary point `x_k` (flat or curved): the suffix leaves `x_j`
+/// along `omega_jk` over `d_jk`, and `refraction = (F, cos_k)` is the Fresnel reflectance of the
+/// refraction at `x_k` and the |cos| of `omega_jk` there.
+#[allow(clippy::too_many_arguments)]
+pub fn pdfs_at(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    si_k: &SurfaceInteraction,
+    omega_jk: Vec3,
+    d_jk: f32,
+    refraction: (f64, f64),
+    light: &LightSample,
+    manifold: f64,
+    channel: usize,
+    check_support: bool,
+    stats: &mut LocalStats,
+) -> EnvPdfs {
+    let (f, cos_k) = refraction;
+    let m = &scene.media[x_j.medium as usize];
     let st = m.sigma_t[channel] as f64;
-    let forward = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp() * (1.0 - r.fresnel as f64);
-    let snee =
-        snee_solid_angle_pdf(scene, opts, x_i, x_j, si_k, light, channel, check_support, r.cos_in as f64, d_jk, stats);
+    let forward = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp() * (1.0 - f);
+    let snee = snee_solid_angle_pdf(scene, opts, x_i, x_j, si_k, light, channel, check_support, cos_k, d_jk, stats);
     let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
     EnvPdfs { manifold: finite(manifold), forward: finite(forward), snee: finite(snee) }
 }
 
-/// SNEE's density of the suffix `x_i → x_j → x_k → light`, in the solid angle of `omega_jk` at
-/// `x_j` conditioned on `x_j` (docs/manifold.md §4.2: its `dV(x_j) dA(x_k)` density divided by
-/// forward's volume density of `x_j` and by `dA(x_k)/dω_jk = d_jk²/cos_k`); 0 where SNEE cannot make
-/// it (no SNEE vertex `x_i` in the same medium, `snee = forward`, or, with `check_support`, `x_k`
-/// hidden from `x_i`: one shadow ray). `cos_k`: |cos| of `omega_jk` at `x_k`.
+/// SNEE's own density `pdf_snee` of the suffix `x_i → x_j → x_k → light` (its `dV(x_j) dA(x_k)`
+/// measure) and its vertex `x_i`; `None` where SNEE cannot make it: no SNEE vertex `x_i` in the
+/// same medium, `snee = forward`, density 0, or, with `check_support`, `x_k` hidden from `x_i` (one
+/// shadow ray, cast only when the density is positive).
+#[allow(clippy::too_many_arguments)]
+pub fn snee_suffix_pdf<'a>(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&'a SneeVertex>,
+    x_j: &MediumVertex,
+    si_k: &SurfaceInteraction,
+    light: &LightSample,
+    channel: usize,
+    check_support: bool,
+    stats: &mut LocalStats,
+) -> Option<(f64, &'a SneeVertex)> {
+    let x_i = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium)?;
+    let tables = super::tables(scene)?;
+    let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
+    let pdf_snee = snee::pdf_snee(scene, tables, &suffix, light, channel);
+    if !(pdf_snee > 0.0) {
+        return None;
+    }
+    if check_support {
+        stats.rays += 1;
+        let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
+        if scene.ray_test(&spawn_ray_between(x_i.p, inner_k)) {
+            return None;
+        }
+    }
+    Some((pdf_snee, x_i))
+}
+
+/// SNEE's density of the suffix in the solid angle of `omega_jk` at `x_j` conditioned on `x_j`
+/// (docs/manifold.md §4.2: [`snee_suffix_pdf`] divided by forward's volume density of `x_j` and by
+/// `dA(x_k)/dω_jk = d_jk²/cos_k`); 0 where SNEE cannot make it. `cos_k`: |cos| of `omega_jk` at `x_k`.
 #[allow(clippy::too_many_arguments)]
 pub fn snee_solid_angle_pdf(
     scene: &Scene,
@@ -113,17 +166,10 @@ pub fn snee_solid_angle_pdf(
     d_jk: f32,
     stats: &mut LocalStats,
 ) -> f64 {
-    let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) else {
+    let Some((pdf_snee, x_i)) = snee_suffix_pdf(scene, opts, x_i, x_j, si_k, light, channel, check_support, stats)
+    else {
         return 0.0;
     };
-    let visible = !check_support || {
-        stats.rays += 1;
-        let inner_k = offset_origin(si_k.p, si_k.n, x_i.p - si_k.p);
-        !scene.ray_test(&spawn_ray_between(x_i.p, inner_k))
-    };
-    let Some(tables) = super::tables(scene).filter(|_| visible) else { return 0.0 };
-    let suffix = SneeSuffix { x_i: *x_i, x_j: x_j.p, si_k: *si_k };
-    let pdf_snee = snee::pdf_snee(scene, tables, &suffix, light, channel);
     let to_sa = p_volume(scene, x_i, x_j.p, channel) * cos_k / (d_jk as f64 * d_jk as f64);
     if to_sa > 0.0 {
         pdf_snee / to_sa
