@@ -17,7 +17,7 @@ use crate::common;
 use snee::bsdf::fresnel::fresnel;
 use snee::color::Spectrum;
 use snee::integrator::manifold::chain;
-use snee::integrator::manifold::newton::{Patch, Surface};
+use snee::integrator::manifold::newton::{sphere_seed, Patch, Surface};
 use snee::integrator::manifold::MediumVertex;
 use snee::integrator::stats::LocalStats;
 use snee::math::{DVec3, Vec3};
@@ -40,10 +40,7 @@ fn ball_scene() -> String {
 }
 
 fn uniform_dir(u: &mut impl FnMut() -> f64) -> DVec3 {
-    let z = 1.0 - 2.0 * u();
-    let phi = std::f64::consts::TAU * u();
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    sphere_seed(u(), u())
 }
 
 #[test]

@@ -29,7 +29,7 @@
 //! probability; no deterministic seed is known for a reflection point), Bernoulli trials capped at
 //! [`MAX_TRIALS`] (capped connections counted in `--stats` as `chain_trials_capped`).
 
-use super::newton::{bernoulli_trials, damped_step, moved, tangents, Failure, Patch, Refracted};
+use super::newton::{bernoulli_trials, damped_step, moved, sphere_seed, tangents, Failure, Patch, Refracted};
 use super::MediumVertex;
 use crate::bsdf::fresnel::fresnel;
 use crate::color::Spectrum;
@@ -188,14 +188,6 @@ pub struct ChainCounts {
     pub iterations: u64,
     pub failures: u64,
     pub capped: u64,
-}
-
-/// A direction uniform on the sphere.
-fn sphere_seed(u1: f64, u2: f64) -> DVec3 {
-    let z = 1.0 - 2.0 * u1;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = std::f64::consts::TAU * u2;
-    DVec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
 /// Specular manifold sampling's unbiased estimate (Zeltner et al. 2020, §4.3) for the chain: one

@@ -331,6 +331,15 @@ impl SolveCounts {
     }
 }
 
+/// A direction uniform on the sphere (in `f64`; `warp::square_to_uniform_sphere` is the `f32` one):
+/// `z = 1 − 2 u1`, `φ = 2π u2`.
+pub fn sphere_seed(u1: f64, u2: f64) -> DVec3 {
+    let z = 1.0 - 2.0 * u1;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * u2;
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
 /// A direction uniform on the hemisphere around `omega_l` (every refraction solution lies there:
 /// the refracted ray turns by less than 90°).
 fn hemisphere_seed(omega_l: DVec3, u1: f64, u2: f64) -> DVec3 {
@@ -518,10 +527,7 @@ mod coverage {
     }
 
     fn uniform_dir(u: &mut impl FnMut() -> f64) -> DVec3 {
-        let z = 1.0 - 2.0 * u();
-        let phi = std::f64::consts::TAU * u();
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        DVec3::new(r * phi.cos(), r * phi.sin(), z)
+        sphere_seed(u(), u())
     }
 
     #[test]
