@@ -105,7 +105,8 @@ pub struct Conductor {
     pub specular_reflectance: Option<Texture>,
 }
 
-pub(super) fn component_flags(i: u32) -> u32 {
+#[inline]
+pub(super) const fn component_flags(i: u32) -> u32 {
     if i == 0 {
         flags::DELTA_REFLECTION | flags::FRONT_SIDE
     } else {

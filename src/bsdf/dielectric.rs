@@ -41,7 +41,8 @@ pub struct Dielectric {
     pub specular_transmittance: Option<Texture>,
 }
 
-pub(super) fn component_flags(i: u32) -> u32 {
+#[inline]
+pub(super) const fn component_flags(i: u32) -> u32 {
     match i {
         0 => flags::DELTA_REFLECTION | flags::FRONT_SIDE | flags::BACK_SIDE,
         1 => flags::DELTA_TRANSMISSION | flags::FRONT_SIDE | flags::BACK_SIDE | flags::NON_SYMMETRIC,

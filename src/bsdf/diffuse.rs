@@ -29,7 +29,8 @@ pub struct Diffuse {
     pub reflectance: Texture,
 }
 
-pub(super) fn component_flags(i: u32) -> u32 {
+#[inline]
+pub(super) const fn component_flags(i: u32) -> u32 {
     if i == 0 {
         flags::DIFFUSE_REFLECTION | flags::FRONT_SIDE
     } else {

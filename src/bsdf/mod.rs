@@ -232,18 +232,28 @@ impl Bsdf {
 
     /// Union of all component flags (Mitsuba's `BSDF::flags()`). Asked at every surface vertex:
     /// the leaf BSDFs have at most two lobes (and flags 0 past their last), so their union is
-    /// that of lobes 0 and 1, without the loop.
+    /// that of lobes 0 and 1, without the loop: a constant per model (`flags_are_the_union_of_the_lobes`
+    /// checks them). The nested models are asked lobe by lobe.
     #[inline]
     pub fn flags(&self) -> u32 {
         match self {
+            Bsdf::Diffuse(_) => diffuse::component_flags(0) | diffuse::component_flags(1),
+            Bsdf::Dielectric(_) => dielectric::component_flags(0) | dielectric::component_flags(1),
+            Bsdf::ThinDielectric(_) => thin_dielectric::component_flags(0) | thin_dielectric::component_flags(1),
+            Bsdf::Null => null::component_flags(0) | null::component_flags(1),
+            Bsdf::Conductor(_) => conductor::component_flags(0) | conductor::component_flags(1),
+            Bsdf::Plastic(_) => plastic::component_flags(0) | plastic::component_flags(1),
+            Bsdf::RoughPlastic(_) => rough_plastic::component_flags(0) | rough_plastic::component_flags(1),
             Bsdf::TwoSided(..) | Bsdf::Mask(_) | Bsdf::RoughDielectric(_) | Bsdf::RoughConductor(_) => {
-                (0..self.component_count()).fold(0, |acc, i| acc | self.component_flags(i))
-            }
-            _ => {
-                debug_assert!(self.component_count() <= 2);
-                self.component_flags(0) | self.component_flags(1)
+                self.nested_flags()
             }
         }
+    }
+
+    /// [`Bsdf::flags`] of the models whose lobes depend on their parameters or children.
+    #[inline(never)]
+    fn nested_flags(&self) -> u32 {
+        (0..self.component_count()).fold(0, |acc, i| acc | self.component_flags(i))
     }
 
     /// True when some lobe of the given type(s) exists.

@@ -16,7 +16,8 @@ use super::{flags, BsdfContext, BsdfSample};
 use crate::color::Spectrum;
 use crate::interaction::SurfaceInteraction;
 
-pub(super) fn component_flags(i: u32) -> u32 {
+#[inline]
+pub(super) const fn component_flags(i: u32) -> u32 {
     if i == 0 {
         flags::NULL | flags::FRONT_SIDE | flags::BACK_SIDE
     } else {

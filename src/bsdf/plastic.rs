@@ -53,7 +53,8 @@ pub struct Plastic {
     pub specular_sampling_weight: f32,
 }
 
-pub(super) fn component_flags(i: u32) -> u32 {
+#[inline]
+pub(super) const fn component_flags(i: u32) -> u32 {
     match i {
         0 => flags::DELTA_REFLECTION | flags::FRONT_SIDE,
         1 => flags::DIFFUSE_REFLECTION | flags::FRONT_SIDE,

@@ -71,7 +71,8 @@ pub struct RoughPlastic {
     pub internal_reflectance: f32,
 }
 
-pub(super) fn component_flags(i: u32) -> u32 {
+#[inline]
+pub(super) const fn component_flags(i: u32) -> u32 {
     match i {
         0 => flags::GLOSSY_REFLECTION | flags::FRONT_SIDE,
         1 => flags::DIFFUSE_REFLECTION | flags::FRONT_SIDE,

@@ -40,7 +40,8 @@ pub struct ThinDielectric {
     pub specular_transmittance: Option<Texture>,
 }
 
-pub(super) fn component_flags(i: u32) -> u32 {
+#[inline]
+pub(super) const fn component_flags(i: u32) -> u32 {
     match i {
         0 => flags::DELTA_REFLECTION | flags::FRONT_SIDE | flags::BACK_SIDE,
         1 => flags::NULL | flags::FRONT_SIDE | flags::BACK_SIDE,

@@ -268,7 +268,23 @@ impl EnvironmentEmitter {
     #[inline]
     pub fn pdf_direction(&self, d: Vec3) -> f32 {
         let local = self.to_local.transform_vector3(d).normalize_or_zero();
-        let (i, j) = self.cell_of(Self::direction_to_uv(local));
+        self.pdf_uv(Self::direction_to_uv(local))
+    }
+
+    /// [`EnvironmentEmitter::eval`] and, with `with_pdf`, [`EnvironmentEmitter::pdf_direction`]
+    /// (else 0) of world direction `d`, mapping `d` to uv once (a ray that escapes after a
+    /// non-delta scattering needs both). The same values as the two calls.
+    #[inline]
+    pub fn eval_pdf(&self, d: Vec3, with_pdf: bool) -> (Spectrum, f32) {
+        let local = self.to_local.transform_vector3(d).normalize_or_zero();
+        let uv = Self::direction_to_uv(local);
+        (self.eval_uv(uv), if with_pdf { self.pdf_uv(uv) } else { 0.0 })
+    }
+
+    /// [`EnvironmentEmitter::pdf_direction`] at Mitsuba's uv of the local direction.
+    #[inline]
+    fn pdf_uv(&self, uv: Vec2) -> f32 {
+        let (i, j) = self.cell_of(uv);
         let omega = self.cell_solid_angle(j);
         if omega > 0.0 {
             self.distr.pmf(i, j) / omega

@@ -110,6 +110,21 @@ impl Emitter {
         }
     }
 
+    /// [`Emitter::eval_environment`] and, with `with_pdf`, [`Emitter::pdf_direction`] (else 0) of
+    /// an escaping ray's direction `d` at once (the envmap maps `d` to its image only once).
+    #[inline]
+    pub fn eval_environment_pdf(&self, d: Vec3, with_pdf: bool) -> (Spectrum, f32) {
+        match self {
+            Emitter::Envmap(e) => e.eval_pdf(d, with_pdf),
+            _ => {
+                let ds = DirectionSample { d, dist: f32::INFINITY, ..Default::default() };
+                // Infinitely distant: the density does not depend on the reference point.
+                let pdf = if with_pdf { self.pdf_direction(Vec3::ZERO, &ds) } else { 0.0 };
+                (self.eval_environment(d), pdf)
+            }
+        }
+    }
+
     /// Radiance arriving along a ray that escapes the scene in world direction `d` (unit, pointing
     /// away from the scene): Mitsuba's `eval` with `si.wi = -d`. Zero for non-environment emitters.
     #[inline]

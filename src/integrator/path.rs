@@ -11,7 +11,7 @@ use crate::bsdf::{flags, BsdfContext};
 use crate::color::Spectrum;
 use crate::math::{mis_weight, Ray};
 use crate::sampler::Sampler;
-use crate::scene::world::Scene;
+use crate::scene::world::{Scene, SceneEmitter};
 
 /// Radiance along `ray` (one sample), and whether the camera ray hit a surface (the alpha channel).
 pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
@@ -46,13 +46,14 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
         match &si {
             None => {
                 if !hide {
-                    if let Some(env) = scene.environment {
-                        let le = scene.eval_environment(ray.d);
+                    if let Some(SceneEmitter::Other(env)) = scene.environment.map(|e| &scene.emitters[e as usize]) {
+                        // Radiance and (after non-delta scattering) the emitter-sampling density of
+                        // the escape direction, which the envmap maps to its image once for both.
+                        let (le, pdf) = env.eval_environment_pdf(ray.d, !prev_bsdf_delta);
                         let mis = if prev_bsdf_delta {
                             1.0
                         } else {
-                            let ds = scene.environment_direction_sample(env, ray.d);
-                            mis_weight(prev_bsdf_pdf, scene.pdf_emitter_direction(prev_p, &ds))
+                            mis_weight(prev_bsdf_pdf, pdf * scene.emitter_selection_pdf())
                         };
                         result += beta * le * mis;
                     }

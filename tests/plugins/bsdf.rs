@@ -596,3 +596,25 @@ fn diffuse_and_twosided_match_mitsuba() {
         }
     }
 }
+
+/// `Bsdf::flags` (a constant per leaf model) is the union of the flags of every lobe.
+#[test]
+fn flags_are_the_union_of_the_lobes() {
+    let plugins = [
+        "diffuse",
+        "dielectric",
+        "thindielectric",
+        "roughdielectric",
+        "null",
+        "conductor",
+        "roughconductor",
+        "plastic",
+        "roughplastic",
+    ];
+    for plugin in plugins {
+        let bsdf = load_bsdf(plugin, vec![]);
+        let union = (0..bsdf.component_count() + 2).fold(0, |acc, i| acc | bsdf.component_flags(i));
+        assert_eq!(bsdf.flags(), union, "{plugin}");
+        assert_ne!(union, 0, "{plugin}");
+    }
+}
