@@ -55,8 +55,19 @@ impl Texture {
         Ok(t)
     }
 
-    #[inline]
+    /// The value at `uv`. Constants (most reflectances and radiances) are read in place; the
+    /// spatially varying textures are evaluated out of line, so that this stays small enough to
+    /// inline at every BSDF and emitter evaluation.
+    #[inline(always)]
     pub fn eval(&self, uv: Vec2) -> Spectrum {
+        match self {
+            Texture::Const(c) => *c,
+            _ => self.eval_varying(uv),
+        }
+    }
+
+    #[inline(never)]
+    fn eval_varying(&self, uv: Vec2) -> Spectrum {
         match self {
             Texture::Const(c) => *c,
             Texture::Checkerboard(t) => t.eval(uv),
