@@ -25,6 +25,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 const TILE: u32 = 16;
+/// Most bytes of tile blocks held at once when several passes render together (`render_range`).
+const FUSED_BLOCK_BYTES: usize = 256 << 20;
 
 #[derive(Clone, Debug, Default)]
 pub struct RenderOptions {
@@ -286,6 +288,60 @@ pub fn render_range(
             }
         };
 
+    // One tile's samples `next..pass_end` of every pixel (the chunk starting at `chunk` replayed
+    // up to `next`), splatted into a block of its own with the samples' count; `None` when
+    // cancelled before it started.
+    let render_tile = |&(x0, y0, w, h): &(i32, i32, u32, u32), chunk: u32, next: u32, pass_end: u32| {
+        let (replay, pass_spp) = (next - chunk, pass_end - next);
+        if cancel.load(Ordering::Relaxed) {
+            return None;
+        }
+        let mut block = ImageBlock::new((x0, y0), (w, h), film.filter, nch);
+        let mut local = LocalStats::default();
+        let mut replayed = LocalStats::default();
+        let mut values = vec![0.0f32; nch];
+        let mut split = [Spectrum::ZERO; N_CLASSES];
+        for y in y0..y0 + h as i32 {
+            for x in x0..x0 + w as i32 {
+                // Unique per film pixel (the border may lie outside the film: offset it).
+                let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
+                let mut sampler =
+                    Sampler::new(opts.seed, pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(chunk as u64));
+                for _ in 0..replay {
+                    take_sample(&mut sampler, &mut replayed, x, y, classes.then_some(&mut split));
+                }
+                for _ in 0..pass_spp {
+                    let (pos, l, valid) = take_sample(&mut sampler, &mut local, x, y, classes.then_some(&mut split));
+                    values[..3].copy_from_slice(&l.to_array());
+                    let mut k = 3;
+                    if rgba {
+                        values[3] = if valid { 1.0 } else { 0.0 };
+                        k = 4;
+                    }
+                    if moment {
+                        values[k..k + 3].copy_from_slice(&(l * l).to_array());
+                        k += 3;
+                    }
+                    if classes {
+                        for v in &split {
+                            values[k..k + 3].copy_from_slice(&v.to_array());
+                            k += 3;
+                            if moment {
+                                values[k..k + 3].copy_from_slice(&(*v * *v).to_array());
+                                k += 3;
+                            }
+                        }
+                    }
+                    block.put(pos, &values);
+                }
+            }
+        }
+        stats.add(&local);
+        let n = w as u64 * h as u64 * pass_spp as u64;
+        bar.inc(n);
+        Some((block, n))
+    };
+
     // Next sample index per pixel; the image holds samples start_sample..next.
     let mut next = start_sample;
     let mut samples_done = 0u64;
@@ -315,76 +371,50 @@ pub fn render_range(
                 }
             }
         }
-        let pass_spp = pass_end - next;
-        // Samples chunk..next of the chunk's stream are replayed (not recorded) when a range or a
-        // resumed render starts inside a chunk.
-        let replay = next - chunk;
-        let completed = std::sync::atomic::AtomicU64::new(0);
-        // Tiles render in parallel; their blocks merge in tile order so the floating-point sums (and
-        // so the image) do not depend on the thread count.
-        let blocks: Vec<Option<ImageBlock>> = tiles
-            .par_iter()
-            .map(|&(x0, y0, w, h)| {
-                if cancel.load(Ordering::Relaxed) {
-                    return None;
-                }
-                let mut block = ImageBlock::new((x0, y0), (w, h), film.filter, nch);
-                let mut local = LocalStats::default();
-                let mut replayed = LocalStats::default();
-                let mut values = vec![0.0f32; nch];
-                let mut split = [Spectrum::ZERO; N_CLASSES];
-                for y in y0..y0 + h as i32 {
-                    for x in x0..x0 + w as i32 {
-                        // Unique per film pixel (the border may lie outside the film: offset it).
-                        let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
-                        let mut sampler =
-                            Sampler::new(opts.seed, pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(chunk as u64));
-                        for _ in 0..replay {
-                            take_sample(&mut sampler, &mut replayed, x, y, classes.then_some(&mut split));
-                        }
-                        for _ in 0..pass_spp {
-                            let (pos, l, valid) =
-                                take_sample(&mut sampler, &mut local, x, y, classes.then_some(&mut split));
-                            values[..3].copy_from_slice(&l.to_array());
-                            let mut k = 3;
-                            if rgba {
-                                values[3] = if valid { 1.0 } else { 0.0 };
-                                k = 4;
-                            }
-                            if moment {
-                                values[k..k + 3].copy_from_slice(&(l * l).to_array());
-                                k += 3;
-                            }
-                            if classes {
-                                for v in &split {
-                                    values[k..k + 3].copy_from_slice(&v.to_array());
-                                    k += 3;
-                                    if moment {
-                                        values[k..k + 3].copy_from_slice(&(*v * *v).to_array());
-                                        k += 3;
-                                    }
-                                }
-                            }
-                            block.put(pos, &values);
-                        }
-                    }
-                }
-                stats.add(&local);
-                let n = w as u64 * h as u64 * pass_spp as u64;
-                completed.fetch_add(n, Ordering::Relaxed);
-                bar.inc(n);
-                Some(block)
+        // The passes rendered together: this one, and, when nothing needs the image between
+        // passes (no callback, no time budget), the following ones up to the end or
+        // `FUSED_BLOCK_BYTES` of blocks, so that threads go from one pass to the next without
+        // waiting for each other.
+        let mut passes = vec![(chunk, next, pass_end)];
+        if on_pass.is_none() && opts.time_budget.is_none() {
+            let tile_bytes = (TILE + 2 * film.filter.border_size()).pow(2) as usize * (nch + 1) * 4;
+            let max_passes = (FUSED_BLOCK_BYTES / (tile_bytes * tiles.len())).max(1);
+            while passes.len() < max_passes && passes[passes.len() - 1].2 < end_sample {
+                let n = passes[passes.len() - 1].2;
+                passes.push((chunk_start(n), n, chunk_end(n).min(end_sample)));
+            }
+        }
+        // Tiles render in parallel, one job each (rayon would otherwise hand a thread runs of
+        // tiles that cannot be stolen, and the other thread waits for the run's end), in pass
+        // order; their blocks merge pass by pass in tile order, so the floating-point sums (and
+        // so the image) do not depend on the thread count or on how passes were grouped.
+        let nt = tiles.len();
+        let blocks: Vec<Option<(ImageBlock, u64)>> = (0..passes.len() * nt)
+            .into_par_iter()
+            .with_max_len(1)
+            .map(|k| {
+                let (chunk, next, pass_end) = passes[k / nt];
+                render_tile(&tiles[k % nt], chunk, next, pass_end)
             })
             .collect();
-        // A pass stopped part way is dropped whole, so the image holds whole sample ranges.
-        if cancel.load(Ordering::Relaxed) || blocks.iter().any(|b| b.is_none()) {
+        // A pass stopped part way is dropped whole, so the image holds whole sample ranges: the
+        // complete passes before the first incomplete one are kept.
+        let mut stopped = false;
+        for (pass, pass_blocks) in passes.iter().zip(blocks.chunks(nt)) {
+            if pass_blocks.iter().any(|b| b.is_none()) {
+                stopped = true;
+                break;
+            }
+            for (block, n) in pass_blocks.iter().flatten() {
+                full.merge(block);
+                samples_done += n;
+            }
+            pass_end = pass.2;
+            next = pass_end;
+        }
+        if stopped || cancel.load(Ordering::Relaxed) {
             break;
         }
-        for block in blocks.iter().flatten() {
-            full.merge(block);
-        }
-        samples_done += completed.load(Ordering::Relaxed);
-        next = pass_end;
         if let Some(cb) = on_pass.as_mut() {
             let t0 = Instant::now();
             let state = PassState {
@@ -404,8 +434,9 @@ pub fn render_range(
         }
     }
     bar.finish_and_clear();
-    let seconds = start.elapsed().as_secs_f64() - callback_seconds;
+    // The developed image is part of the render time (as in Mitsuba's `render`, which returns it).
     let data = full.develop();
+    let seconds = start.elapsed().as_secs_f64() - callback_seconds;
     RenderOutput {
         width: cw as usize,
         height: ch as usize,
