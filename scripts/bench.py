@@ -3,8 +3,10 @@
 
 snee:    `cargo build --release` first (not timed), then
          `cargo run --release -- render SCENE -o OUT/snee.exr --spp N --stats OUT/snee_stats.json`.
-         Its render time is read from the stats file (keys `seconds`, `spp`, `samples_per_second`);
-         the process's wall time (scene loading, BVH build, EXR writing included) is shown too.
+         Its render time is read from the stats file (keys `seconds`, `spp`, `samples_per_second`):
+         from the first sample to the developed image in memory (every pass, the merge of the tile
+         blocks and the film development; not scene loading, BVH build or EXR writing, like
+         Mitsuba's time below). The process's wall time (all of it included) is shown too.
 Mitsuba: variant llvm_ad_rgb (falls back to scalar_rgb), the same scene file and spp, rendered with
          `mi.render` once as a warm-up so that the LLVM JIT compilation of the kernels is EXCLUDED
          from the timing, then rendered again (another seed) and timed until the image is in memory.

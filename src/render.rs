@@ -10,6 +10,10 @@
 //! full run (a range that starts inside a chunk replays the chunk's earlier samples without
 //! recording them, so ranges on chunk boundaries cost nothing extra), and ranges merge into the
 //! full image up to float summation order (`merge`).
+//!
+//! Each (tile, pass) is one parallel job with a block of its own; blocks merge into the image
+//! pass by pass in tile order. Without a pass callback or a time budget, consecutive passes run in
+//! one parallel loop (no barrier between passes), with the same merge order, so the same image.
 
 use crate::color::Spectrum;
 use crate::integrator::classes::{ClassValues, PathClass, N_CLASSES};
@@ -25,8 +29,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 const TILE: u32 = 16;
-/// Most bytes of tile blocks held at once when several passes render together (`render_range`).
-const FUSED_BLOCK_BYTES: usize = 256 << 20;
+/// Most bytes of tile blocks held at once when several passes render together (`render_range`):
+/// small and medium films fuse all their passes, large ones (over 32 MB of blocks per pass) render
+/// pass by pass as before.
+const FUSED_BLOCK_BYTES: usize = 64 << 20;
 
 #[derive(Clone, Debug, Default)]
 pub struct RenderOptions {

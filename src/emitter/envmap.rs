@@ -313,8 +313,8 @@ impl std::fmt::Debug for EnvironmentEmitter {
 #[inline(always)]
 fn fract(v: f32) -> f32 {
     if !(v.abs() < 8_388_608.0) {
-        // Integers already (2^23 and above), or not finite.
-        return v - v;
+        // Integers already (2^23 and above): 0; not finite: NaN.
+        return if v.is_finite() { 0.0 } else { f32::NAN };
     }
     let i = v as i32 as f32;
     v - if i > v { i - 1.0 } else { i }
