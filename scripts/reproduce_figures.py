@@ -5,7 +5,7 @@ scripts/make_figure_assets.py): light in {envmap, sphere (0.006 sr), directional
 ggx004, smooth}, extinction in {st02 (2 /m), st34 (34 /m)}; medium albedo 0.8, isotropic.
 
     python3 scripts/reproduce_figures.py --standard --refs-only --refs DIR   # references ahead, any load
-    python3 scripts/reproduce_figures.py --standard --refs DIR --work WORK   # ~30 min on 2 idle cores
+    python3 scripts/reproduce_figures.py --standard --refs DIR --work WORK   # ~45 min on 2 idle cores
     python3 scripts/reproduce_figures.py --paper [--address auto]   # Ray cluster; figures/paper_size/
 
 Per configuration (one after the other; cached per render and per configuration in --work, the
@@ -60,35 +60,82 @@ Runs (interleaved: volpath, volpath_snee, [complete,] Mitsuba, volpath, ... so a
   per-channel RGB variances need cross moments it does not write (R is a combination of X, Y, Z).
   One untimed warm-up of each kernel at n compiles them first. Variant llvm_ad_rgb (else
   scalar_rgb), dr.set_thread_count(THREADS).
+Sequential runs (a rule fixed before it ran on any configuration; every mode): after the first RUNS
+  runs, a configuration where a compared method's V rests on fewer than NEFF_MIN (10) effective runs
+  gets RUNS more runs of every method (interleaved as above; run i has seed base + i, so new runs
+  have new seeds), and again, until every compared method is at >= 10 or one more batch would pass
+  the cap (max_runs: standard 48, paper 24, smoke 6; --max-runs overrides it, --max-runs RUNS is
+  the fixed design). The rule reads only the runs' V_run, never a ratio, the reference or another
+  configuration. JSON: runs, sequential (each step's effective runs), per method n_eff_runs and
+  V_first_batch (V of the first RUNS runs: the fixed design's).
+  * Effective runs: V is the mean of the runs' V_run; with w_i = V_run_i / sum V_run the runs'
+    shares, Kish's n_eff = 1 / sum w_i^2 = (sum V_run)^2 / sum V_run^2 = N / (1 + CV^2) (CV: the
+    V_run's coefficient of variation, ddof 0): N for equal runs, 1 when one run carries all. The
+    bootstrap resamples runs, so n_eff is how many units its interval really rests on. Why 10: the
+    largest share is >= 1 / n_eff, so below 10 a single run carries more than a tenth of V, more than
+    the summary's +-10 % resolution, and whether it (or another like it) was drawn moves the
+    ratios by more than that; at N = 16 it means CV > 0.77, a relative standard error of V of
+    sqrt(1 / n_eff - 1 / N) > 19 %.
+  * Not counted: methods that cannot sample the configuration's transport (CANNOT_SAMPLE: volpath
+    and Mitsuba under directional + smooth, known a priori; their V is that of another integral).
+  * The cap: a batch of 16 x 1 s costs ~85 s with 4 methods on 2 idle cores. In the 16-run study
+    committed before this rule, 8 of 18 configurations had a method below 10 at 16 runs (4 of them
+    below 5); at two batches (the cap) for those 4 and one for the others, ~12 batches, ~17 min:
+    ~47 min in all; if every configuration ran to 48, ~80 min, within the 90 min the standard size
+    must fit (a cap of 64 could reach ~130 min).
+  * Bias of stopping on the tails: more runs follow where the first runs happened to hold rare large
+    V_run (V high, n_eff low) and none where they did not (V low), so the final V is biased low (V of
+    the first RUNS runs is not). Simulated (20000 repetitions of the rule, against the first 16 runs
+    of the same repetitions) with the 64 real V_run of volpath_snee on sphere_ggx004_st34 as the
+    population: -2.5 % on V (28 runs on average); lognormal V_run (sigma 1, 1.5): -2.8 %, -3 %;
+    Pareto (alpha 2.5, 1.8): -2.2 %, -6.5 %: small against the intervals (median x/÷ 1.25 in
+    the 16-run study). The efficiency 1 / (V c) is biased up at any fixed N (Jensen:
+    +7 %, +10 %, +35 %, +3 %, +10 % at 16 runs there), which the rule changes by -14 to +3 points. The
+    rule does not raise the intervals' coverage (a tail no run drew is missing either way; 95 % BCa
+    intervals of V, 400 repetitions: 0.89 fixed 16 and 0.86 sequential on the real runs, 0.92 at a
+    fixed 32); what it buys is fewer cells resting on one or two runs. The cap bounds the cost;
+    where a method is still below 10 at the cap, its ratio cells are flagged (‡ in the table).
 
 Efficiency (per method): V = per-sample relative variance = mean over pixels and channels of
-sigma^2_p / (d_p^2 + eps); c = seconds per sample per pixel = sum t / (RUNS n); a render of time t has
+sigma^2_p / (d_p^2 + eps); c = seconds per sample per pixel = sum t / (N n); a render of time t has
 relative variance RV(t) = V c / t, so efficiency = 1 / (RV t) = 1 / (V c).
   * V from per-pixel moments, the same way for every method (snee's and Mitsuba's): per run,
     sigma^2_p = (m2_p - x_p^2) n / (n - 1) (m2 is the per-pixel mean of the squared samples;
     unbiased per run); V_run = mean over pixels and channels of sigma^2_p / (d_p^2 + eps); V = mean
     over runs.
   * A check (JSON V_spread, V_over_V_spread = [V / V_spread, 95 % bootstrap interval]): V from the
-    spread of the runs: with s^2_p the sample variance (ddof 1) of pixel p over the RUNS runs,
+    spread of the runs: with s^2_p the sample variance (ddof 1) of pixel p over the N runs,
     E[s^2_p] = sigma^2_p / n, so V_spread = n * mean(s^2_p / (d^2 + eps)) estimates the same
     quantity from the same samples (before Mitsuba's runs had moments, its V).
   * Ratios volpath_snee / volpath, volpath_snee / Mitsuba volpath (and complete / volpath_snee),
-    with a 95 % percentile bootstrap over runs (run indices resampled jointly for all methods:
+    with a 95 % BCa bootstrap over the N runs (run indices resampled jointly for all methods:
     interleaved runs share the load); in the V_spread check's bootstrap a resampled spread estimate
-    is multiplied by RUNS / (RUNS - 1) (the bootstrap's bias of a ddof-1 variance). An undecided
-    ratio whose interval lies within [1/1.1, 1.1] is counted as "equal within +-10 %". Seed stability: every ratio is also computed
-    from each half of the runs (seeds +0..7 and +8..15, JSON `halves`, with their own bootstrap
-    intervals); the summary counts the configurations whose two halves' intervals overlap and, where
-    they do not, names the method whose V differs most between the halves (JSON V_halves). JSON
-    V_top_pixel_share: per run, the largest single pixel's share of V_run, averaged over the runs
-    (near 1: V rests on a few rare, bright samples, and 8 runs may or may not contain one).
+    is multiplied by N / (N - 1) (the bootstrap's bias of a ddof-1 variance). An undecided
+    ratio whose interval lies within [1/1.1, 1.1] is counted as "equal within +-10 %". Seed
+    stability: every ratio is also computed from each half of the runs (seeds +0..N/2-1 and
+    +N/2..N-1, JSON `halves`, with their own bootstrap intervals); the summary counts the
+    configurations whose two halves' intervals overlap and, where they do not, names the method
+    whose V differs most between the halves (JSON V_halves). JSON V_top_pixel_share: per run, the
+    largest single pixel's share of V_run, averaged over the runs (near 1: V rests on a few rare,
+    bright samples, and 8 runs may or may not contain one).
+  * Why BCa (common.bootstrap_ci; Efron & Tibshirani 1993, Ch. 14) and not the percentile interval:
+    V_run is right-skewed where V rests on rare bright samples, so the mean of 16 of them is
+    skewed and the percentile interval's upper end is too low (its misses lie below the truth).
+    BCa moves the quantile levels by the replicates' median bias and the jackknife's skewness
+    (acceleration); it is second-order accurate for smooth functions of means such as the
+    efficiency ratio, where the percentile interval is first-order. Coverage of 95 % intervals of V
+    from 16 runs (400 repetitions, common.bootstrap_ci): runs drawn from the 64 real V_run of
+    volpath_snee on sphere_ggx004_st34, percentile 0.88, BCa 0.89 (drawn without replacement, as
+    a check: 0.89 and 0.94); lognormal V_run sigma 1 / 1.5: 0.84 / 0.72 and 0.87 / 0.79; Pareto
+    alpha 2.5 / 1.8: 0.81 / 0.68 and 0.83 / 0.72. Better in every case, nominal in none: a tail that
+    no run drew widens no interval.
   * Why 16 runs x 1 s (figures/README.md, "Choosing the standard size"): V is a mean of squared,
     heavy-tailed samples; its relative error falls as 1/sqrt(samples per method), and the width of
     the intervals is set by the samples, not by the number of pixels, so the standard size buys
     samples (~16 M per method on 2 idle cores) and enough runs (16) for the bootstrap.
   * A ratio where the compared method fails the bias test measures the variance of an estimate of
     a different integral (volpath under directional + smooth is black): flagged in the table.
-Bias: image mean (pixels and channels) of the RUNS-run average against the reference; standard
+Bias: image mean (pixels and channels) of the N-run average against the reference; standard
   error from the moments (every method; for Mitsuba also, as a check, a t statistic from the spread
   of the runs' means: JSON t_stat_spread), plus the reference's; |z| judged at the Sidak threshold
   for family-wise 1 % over all tests.
@@ -104,17 +151,17 @@ Transport classes: when `snee render --help` lists --classes, one more untimed r
   <= CLASS_SUM_TOL = 1e-5, float32 rounding) -- on every configuration.
 Figure 3: equal samples (FIG3_SPP), transport = snee: volpath_snee snee = forward (left halves)
   against snee = mis with snee_rate = 1 (right halves); z of the image means.
-Figure 4: the average of the RUNS runs (equal time) of volpath | volpath_snee, and Mitsuba | snee.
+Figure 4: the average of the N runs (equal time) of volpath | volpath_snee, and Mitsuba | snee.
 
 Time: the script prints an a-priori estimate (estimate_seconds) at the start, a projection after
 each configuration and the wall time at the end; the JSON has each configuration's phases
 (`timing`). References missing from --refs are rendered (or topped up) first and add to it.
 
 Sizes:
-  --standard  RUN_TIME 1 s x 16 runs (probe 0.25 s), references 1/2 resolution at >= 100 x a volpath
-              run's spp (8 parts), directional + smooth 2 x that per radius, FIG3_SPP 32, 2 threads,
-              firefly renders at 6x resolution. Outputs committed in figures/.
-  --paper     RUN_TIME 30 s x 8 runs, references >= 100 x (10 parts), FIG3_SPP 500 (the paper's), 1
+  --standard  RUN_TIME 1 s x 16 runs (up to 48, sequential), probe 0.25 s, references 1/2 resolution at
+              >= 100 x a volpath run's spp (8 parts), directional + smooth 1 x that per radius, FIG3_SPP
+              32, 2 threads, firefly renders at 6x resolution. Outputs committed in figures/.
+  --paper     RUN_TIME 30 s x 8 runs (up to 24), references >= 100 x (10 parts), FIG3_SPP 500 (the paper's), 1
               thread per task, firefly renders at 16x resolution; each configuration is one Ray task
               (`ray.init()` here by default, --address to join a cluster started with `ray start`;
               --work and --refs must then be folders every node sees). Outputs in figures/paper_size/.
@@ -154,14 +201,14 @@ LABEL = {"envmap": "envmap", "sphere": "sphere 0.006 sr", "directional": "direct
 MODES = {
     "standard": {"fig3_spp": 32, "run_time": 1.0, "runs": 16, "probe": 0.25, "ref_factor": 100, "ref_parts": 8,
                  "ref_scale": 2, "ds_factor": 1, "d_factor": 25, "omegas": [0.006, 0.003, 0.0015],
-                 "firefly_scale": 6, "threads": 2, "boot": 2000},
+                 "firefly_scale": 6, "threads": 2, "boot": 2000, "max_runs": 48},
     "paper": {"fig3_spp": 500, "run_time": 30.0, "runs": 8, "probe": 0.25, "ref_factor": 100, "ref_parts": 10,
               "ref_scale": 2, "ds_factor": 2, "d_factor": 25, "omegas": [0.006, 0.003, 0.0015],
-              "firefly_scale": 16, "threads": 1, "boot": 4000},
+              "firefly_scale": 16, "threads": 1, "boot": 4000, "max_runs": 24},
     # --smoke: a check that the pipeline runs (seconds per configuration); its numbers mean nothing.
     "smoke": {"fig3_spp": 4, "run_time": 0.1, "runs": 3, "probe": 0.5, "ref_factor": 4, "ref_parts": 2,
               "ref_scale": 2, "ds_factor": 1, "d_factor": 2, "omegas": [0.006, 0.003, 0.0015],
-              "firefly_scale": 2, "threads": 2, "boot": 200},
+              "firefly_scale": 2, "threads": 2, "boot": 200, "max_runs": 6},
 }
 # The references' spp come from a CPU-time rate measured on the (possibly loaded) machine that renders
 # them; an idle machine's runs get more spp per second (no hyper-thread or cache contention): the
@@ -172,8 +219,21 @@ FIREFLY_FACTOR = 100.0
 ALPHA = 0.01  # family-wise level of the bias tests
 CLASS_ORDER = ["surface", "single", "snee_support", "snee_hidden", "surface_before_last", "internal_reflection",
                "other"]  # docs/classes.md
+BOOT = "bca"  # the intervals' bootstrap (common.bootstrap_ci); why BCa: the module docstring
 EQUAL_WITHIN = 0.1  # an undecided ratio whose interval lies in [1/1.1, 1.1] reads "equal within +-10 %"
-RUN_COUNTS = (1, 2, 4, 8, 16)  # relMSE of the average of the first k runs (JSON relmse_k, the chart)
+RUN_COUNTS = (1, 2, 4, 8, 16, 32)  # relMSE of the average of the first k runs (and of all; JSON relmse_k, the chart)
+# Sequential runs (module docstring, "Runs"): a configuration where a compared method's V rests on fewer
+# than NEFF_MIN effective runs (Kish) gets more runs, a batch of the mode's `runs` at a time, up to the
+# mode's `max_runs`; where it is still below at the cap, its ratio cells are flagged. Fixed before the
+# extended design ran on any configuration; why 10: see the docstring.
+NEFF_MIN = 10.0
+# (light, boundary) -> methods that cannot sample its transport (a delta light through a delta boundary):
+# their V is that of a different integral, so their effective runs do not extend the runs.
+CANNOT_SAMPLE = {("directional", "smooth"): ("volpath", "mitsuba")}
+# Expected extension batches per configuration, for the a-priori time estimate only: in the committed
+# 16 x 1 s run, 8 of 18 configurations had a compared method below NEFF_MIN at 16 runs; counting the 4 of
+# them below 5 at two batches (to the cap) and the 4 others at one, 12 batches for 18 configurations.
+EXPECTED_BATCHES_PER_CONFIG = 12 / 18
 CLASS_SUM_TOL = 1e-5  # the classes' sum against the image: max |difference| / max |image| (float32 EXR)
 LUM = np.array([0.212671, 0.715160, 0.072169])
 MI_NOT_INSTALLED = 3
@@ -195,6 +255,11 @@ METHODS = [  # key, label, plot style
     ("mitsuba", "Mitsuba volpath", dict(color="C2", marker="^")),
     ("complete", "snee volpath_snee connection=complete", dict(color="C3", marker="D")),
 ]
+
+
+def run_counts(n):
+    """The run counts of relmse_k and the chart: RUN_COUNTS up to n, and n."""
+    return sorted({k for k in RUN_COUNTS if k <= n} | {n})
 
 
 def configs():
@@ -343,6 +408,12 @@ def mitsuba_worker(scene, threads, variant):
     return 0
 
 
+def mi_warm_up(mit, spp):
+    """Untimed renders at the runs' spp that compile the plain and the moment kernel."""
+    for moment in (False, True):
+        mit.call({"cmd": "render", "spp": spp, "seed": 3, "out": None, "moment": moment})
+
+
 class Mitsuba:
     """The persistent worker, started on first use; status "ok", "not installed" or "failed: ..."."""
 
@@ -422,6 +493,15 @@ def class_shares(ch, n, denom):
     return {"V": v_total, "sum_max_rel_diff": float(np.max(np.abs(total - img)) / max(np.max(np.abs(img)), 1e-30)),
             "share": {c: safe_div(float(np.mean(moment_var(ch, n, c + ".") / denom)), v_total) for c in names},
             "energy": {c: safe_div(float(rgb_of(ch, c + ".").sum()), float(img.sum())) for c in names}}
+
+
+def kish(v):
+    """Kish's effective number of runs behind a mean of per-run values v (here V_run): (sum v)^2 /
+    sum v^2 = 1 / sum w_i^2 with w_i = v_i / sum v the runs' shares; N for equal runs, 1 when one run
+    carries everything; the largest share is >= 1 / kish. None when every v is 0 (nothing to estimate)."""
+    v = np.asarray(v, dtype=np.float64)
+    ss = float(np.sum(v * v))
+    return float(np.sum(v)) ** 2 / ss if ss > 0 else None
 
 
 def safe_div(a, b):
@@ -637,8 +717,7 @@ def run_config(args, P, work, name):
             pr = mit.call({"cmd": "probe", "seconds": P["run_time"]})
             if pr is not None:
                 spp["mitsuba"] = max(2, int(round(pr["rate"] * P["run_time"])))
-                for moment in (False, True):  # warm-ups: compile the plain and the moment kernel
-                    mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 3, "out": None, "moment": moment})
+                mi_warm_up(mit, spp["mitsuba"])
                 # The probe's small renders carry a fixed cost per call, so its rate is low: one timed
                 # render at that spp corrects n so that a run takes about run_time, like snee's.
                 t = mit.call({"cmd": "render", "spp": spp["mitsuba"], "seed": 4, "out": None})
@@ -663,29 +742,59 @@ def run_config(args, P, work, name):
         res["reference"]["spp_over_volpath_run_spp"] = ref["spp"] / spp["volpath"]
 
     t1 = time.time()
-    seeds = {"volpath": 100, "snee": 200, "complete": 300}
-    for i in range(P["runs"]):
+    seeds = {"volpath": 100, "snee": 200, "complete": 300}  # + run index (< 100: the seed ranges stay disjoint)
+    mi_state = {"warm": mit is not None and mit.proc is not None, "failed": False}
+
+    def one_run(i):
+        """Run i of every method, interleaved; each run's V_run (its per-pixel variances over d^2 + eps)."""
         for m in snee_methods:
             ch, st = snee_render(args, work, variant_xml(work, name, m), f"{name}.{m}.run{i}",
                                  seed=seeds[m] + i, spp=spp[m], extra=["--moment"])
-            runs[m].append({"x": rgb_of(ch), "var": moment_var(ch, st["spp"]), "n": st["spp"], "t": st["seconds"]})
-        if "mitsuba" in spp:  # a plain render (timed) and the same samples with rgb_moment (mitsuba_worker)
+            var = moment_var(ch, st["spp"])
+            runs[m].append({"x": rgb_of(ch), "var": var, "V": float(np.mean(var / denom)), "n": st["spp"],
+                            "t": st["seconds"]})
+        if "mitsuba" in spp and not mi_state["failed"]:  # a plain render (timed), the same samples with rgb_moment
             npy = os.path.join(work, "renders", f"{name}.{MI_RUN}{i}.npy")
             tj = npy[:-4] + ".json"
             if args.force_renders or not (os.path.exists(npy) and os.path.exists(tj)):
                 RENDERED[0] += 1
+                if not mi_state["warm"]:  # a worker started for extension runs only: compile first, untimed
+                    mi_warm_up(mit, spp["mitsuba"])
+                    mi_state["warm"] = True
                 t = mit.call({"cmd": "run", "spp": spp["mitsuba"], "seed": 1000 + i, "out": npy})
                 if t is None:
-                    break
+                    mi_state["failed"] = True
+                    return
                 common.write_json_atomic(tj, t)
             with open(tj) as fh:
                 t = json.load(fh)
             mom = np.load(npy).astype(np.float64)
-            runs["mitsuba"].append({"x": mom[..., :3], "var": sample_var(mom[..., :3], mom[..., 3:], t["spp"]),
-                                    "n": t["spp"], "t": t["seconds"], "t_moment": t["moment_seconds"],
+            var = sample_var(mom[..., :3], mom[..., 3:], t["spp"])
+            runs["mitsuba"].append({"x": mom[..., :3], "var": var, "V": float(np.mean(var / denom)), "n": t["spp"],
+                                    "t": t["seconds"], "t_moment": t["moment_seconds"],
                                     "plain_vs_moment": t["plain_vs_moment"], "cpu": t["cpu_seconds"]})
-    if "mitsuba" in spp and len(runs["mitsuba"]) < P["runs"]:
-        runs["mitsuba"] = []
+
+    # Sequential design (module docstring, "Runs"): batches of P["runs"] until every compared method's
+    # V rests on >= NEFF_MIN effective runs or the cap is reached; decided from the runs alone.
+    light, boundary, _ = name.split("_")
+    excluded = CANNOT_SAMPLE.get((light, boundary), ())
+    cap = max(P["runs"], args.max_runs or P["max_runs"])
+    assert cap < 100, "seeds + run index must stay below the next method's seeds"
+    steps = []
+    while True:
+        for i in range(len(runs["volpath"]), len(runs["volpath"]) + P["runs"]):
+            one_run(i)
+        n_done = len(runs["volpath"])
+        if mi_state["failed"] or ("mitsuba" in spp and len(runs["mitsuba"]) < n_done):
+            runs["mitsuba"], mi_state["failed"] = [], True
+        n_eff = {m: kish([r["V"] for r in rs]) for m, rs in runs.items() if len(rs) == n_done}
+        below = [m for m, k in n_eff.items() if k is not None and k < NEFF_MIN and m not in excluded]
+        steps.append({"runs": n_done, "n_eff": n_eff, "below": below})
+        if not below or n_done + P["runs"] > cap:
+            break
+    res["sequential"] = {"threshold": NEFF_MIN, "batch": P["runs"], "cap": cap, "excluded": list(excluded),
+                         "steps": steps, "runs": n_done, "below_at_end": below}
+    res["runs"] = n_done
     res["mitsuba_status"] = "not run (--no-mitsuba)" if mit is None else mit.status
     res["mitsuba"] = mstat
     timing["runs"] = time.time() - t1
@@ -719,8 +828,8 @@ def run_config(args, P, work, name):
             classes[m] = class_shares(ch, st["spp"], denom)
     timing["classes"] = time.time() - t1
 
-    # Per-method statistics.
-    N = P["runs"]
+    # Per-method statistics, over the N runs of the sequential design.
+    N = n_done
     stats, avg = {}, {}
     for m, rs in runs.items():
         if len(rs) < N:
@@ -746,11 +855,13 @@ def run_config(args, P, work, name):
         s = {"spp": n, "t": t.tolist(), "c": float(t.sum() / (N * n)), "run_means": run_means.tolist(),
              "V_spread": n * float(spread.mean())}
         vpix = [np.mean(r["var"] / denom, axis=-1) for r in rs]  # per run and pixel, from its per-pixel moments
-        vm = np.array([float(v.mean()) for v in vpix])
+        vm = np.array([r["V"] for r in rs])
         # How few samples carry V: per run, the largest single pixel's share of V_run (mean over runs).
         s_top = float(np.mean([safe_div(float(v.max()), float(v.sum())) for v in vpix if v.sum() > 0] or [math.nan]))
         s["V_runs"] = vm.tolist()
         s["V"] = float(vm.mean())
+        s["n_eff_runs"] = kish(vm)  # Kish: the number of equal runs with the same concentration of V
+        s["V_first_batch"] = float(vm[:P["runs"]].mean())  # the fixed design's V (no stopping rule)
         s["V_halves"] = [float(vm[:N // 2].mean()), float(vm[N // 2:2 * (N // 2)].mean())] if N >= 4 else []
         s["V_top_pixel_share"] = s_top
         s["V_from"] = "per-pixel moments" + (" (rgb_moment; t from a plain render of the same samples)"
@@ -776,7 +887,7 @@ def run_config(args, P, work, name):
                  relmse=None if ref["image"] is None else common.rel_mse(downsample(a, s_ref), ref["image"], denom_ref),
                  relmse_k={} if ref["image"] is None else
                  {str(kk): common.rel_mse(downsample(X[:kk].mean(axis=0), s_ref), ref["image"], denom_ref)
-                  for kk in RUN_COUNTS if kk <= N},
+                  for kk in run_counts(N)},
                  firefly_per_1e6=ff.get(m))
         s["_X"] = X
         s["_vspread"] = v_spread
@@ -797,21 +908,25 @@ def run_config(args, P, work, name):
                             ("complete", "mitsuba", "complete/mitsuba")):
         if num in stats and other in stats:
             r = safe_div(stats[num]["efficiency"], stats[other]["efficiency"])
-            lo, hi = common.bootstrap_ci(lambda idx, a=num, o=other: safe_div(eff(a, idx), eff(o, idx)), N, b=P["boot"])
+            lo, hi = common.bootstrap_ci(lambda idx, a=num, o=other: safe_div(eff(a, idx), eff(o, idx)), N, b=P["boot"],
+                                         method=BOOT)
             ratios[key] = {"ratio": r, "lo": lo, "hi": hi, "halves": []}
             for hf in halves:
                 hlo, hhi = common.bootstrap_ci(lambda j, a=num, o=other, hf=hf: safe_div(eff(a, hf[j]), eff(o, hf[j])),
-                                               len(hf), b=P["boot"])
+                                               len(hf), b=P["boot"], method=BOOT)
                 ratios[key]["halves"].append({"ratio": safe_div(eff(num, hf, False), eff(other, hf, False)),
                                               "lo": hlo, "hi": hhi})
     for m in stats:
         v = stats[m]
         v_runs = np.array(v["V_runs"])
-        v["V_ci"] = list(common.bootstrap_ci(lambda idx, v_runs=v_runs: float(np.mean(v_runs[idx])), N, b=P["boot"]))
+        v["V_ci"] = list(common.bootstrap_ci(lambda idx, v_runs=v_runs: float(np.mean(v_runs[idx])), N, b=P["boot"],
+                                             method=BOOT))
         # The two estimates of V from the same runs (moments; spread of the runs' images): their ratio
         # with a bootstrap interval over runs, a check of the moment estimate.
-        v["V_over_V_spread"] = [safe_div(v["V"], v["V_spread"]), *common.bootstrap_ci(
-            lambda idx, v_runs=v_runs, f=v["_vspread"]: safe_div(float(np.mean(v_runs[idx])), f(idx)), N, b=P["boot"])]
+        point = safe_div(v["V"], v["V_spread"])
+        v["V_over_V_spread"] = [point, *common.bootstrap_ci(
+            lambda idx, v_runs=v_runs, f=v["_vspread"]: safe_div(float(np.mean(v_runs[idx])), f(idx)), N, b=P["boot"],
+            method=BOOT, theta=point)]
         del v["_X"], v["_vspread"]
     res["methods"] = stats
     res["ratios"] = ratios
@@ -855,14 +970,15 @@ FIXED_PER_CONFIG = 8.0  # complete check, firefly renders, Figure 3 renders
 REPORT = 30.0  # the report's statistics and figures, once
 
 
-def estimate_seconds(P, names, complete_configs):
+def estimate_seconds(P, names, complete_configs, batches=0.0):
     """Predicted wall time of the runs (references cached): every method renders a probe and the runs
-    of run_time each, snee methods one more (classes) at about 1.3 run_time."""
+    of run_time each, snee methods one more (classes) at about 1.3 run_time; batches: extension
+    batches of P["runs"] runs per configuration (the sequential design; 0: none)."""
     total = REPORT
     for name in names:
         m_snee = 3 if name in complete_configs else 2
         per_run = m_snee * (P["run_time"] + SNEE_START) + MITSUBA_PER_RUN * P["run_time"]
-        total += (P["runs"] * per_run + m_snee * (P["probe"] * P["run_time"] + SNEE_START)
+        total += ((1 + batches) * P["runs"] * per_run + m_snee * (P["probe"] * P["run_time"] + SNEE_START)
                   + m_snee * (1.3 * P["run_time"] + SNEE_START) + MITSUBA_SETUP + 2 * P["run_time"] + FIXED_PER_CONFIG)
     return total
 
@@ -986,7 +1102,7 @@ def chart_png(path, results, P, note):
                 s = res["methods"].get(key)
                 if not s:
                     continue
-                ks = np.array([kk for kk in RUN_COUNTS if kk <= P["runs"]])
+                ks = np.array(run_counts(res.get("runs", P["runs"])))
                 tk = ks * float(np.mean(s["t"]))
                 # At the reference's resolution (the markers'): a block of s^2 independent pixels with one
                 # d has 1/s^2 of their relative variance, so RV there is exactly V c / (t s^2).
@@ -1003,8 +1119,9 @@ def chart_png(path, results, P, note):
             if rv_ref:
                 hr = ax.axhline(rv_ref, color="gray", ls=":", lw=0.8, label="reference's own RV")
                 handles[hr.get_label()] = hr
-            ax.xaxis.set_major_locator(FixedLocator([float(np.mean(res["methods"][m]["t"])) * kk for m in
-                                                     list(res["methods"])[:1] for kk in RUN_COUNTS if kk <= P["runs"]]))
+            ax.xaxis.set_major_locator(FixedLocator([float(np.mean(res["methods"][m]["t"])) * kk
+                                                     for m in list(res["methods"])[:1]
+                                                     for kk in run_counts(res.get("runs", P["runs"]))]))
             ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
             ax.xaxis.set_minor_locator(NullLocator())
             ax.yaxis.set_minor_formatter(NullFormatter())
@@ -1030,6 +1147,12 @@ def report(args, P, mode, work, names, results, total, load):
     mi_v = sorted({r["methods"]["mitsuba"].get("V_from", "the spread of the runs' images")
                    for r in results.values() if "mitsuba" in r["methods"]})
 
+    def few_runs(r, *ms):
+        """The mark " ‡" where a method's V rests on < NEFF_MIN effective runs (after the sequential runs)."""
+        excluded = (r.get("sequential") or {}).get("excluded", [])
+        k = [r["methods"].get(m, {}).get("n_eff_runs") for m in ms if m not in excluded]
+        return " ‡" if any(x is not None and x < NEFF_MIN for x in k) else ""
+
     def ratio_cell(r, other):
         q = r["ratios"].get(other)
         if not q:
@@ -1040,7 +1163,7 @@ def report(args, P, mode, work, names, results, total, load):
         zo = r["methods"][other]["z"]
         if zo is not None and abs(zo) > zcrit:
             flag = " †"
-        return f"{fmt(q['ratio'])} [{fmt(q['lo'])}, {fmt(q['hi'])}]{flag}"
+        return f"{fmt(q['ratio'])} [{fmt(q['lo'])}, {fmt(q['hi'])}]{flag}{few_runs(r, 'snee', other)}"
 
     def complete_cell(r):
         c = r.get("complete") or {}
@@ -1052,7 +1175,7 @@ def report(args, P, mode, work, names, results, total, load):
             return "not run"
         z = s["z"]
         zs = "n/a" if z is None else (f"**{z:.1f}**" if abs(z) > zcrit else f"{z:.1f}")
-        return f"{fmt(q['ratio'])} [{fmt(q['lo'])}, {fmt(q['hi'])}], z {zs}"
+        return f"{fmt(q['ratio'])} [{fmt(q['lo'])}, {fmt(q['hi'])}]{few_runs(r, 'complete', 'snee')}, z {zs}"
 
     def z_cell(r):
         cells = []
@@ -1079,7 +1202,9 @@ def report(args, P, mode, work, names, results, total, load):
         kind = "sphere → 0 sr" if "sphere" in ref["kind"] else "volpath"
         factor = ref.get("spp_over_volpath_run_spp")
         factor = f"; ×{factor:.0f}" if factor else ""
-        lines.append(f"| {name} | {ratio_cell(r, 'volpath')} | {ratio_cell(r, 'mitsuba')} | {z_cell(r)} | "
+        n_runs = r.get("runs", P["runs"])
+        runs_note = f" ({n_runs} runs)" if n_runs != P["runs"] else ""
+        lines.append(f"| {name}{runs_note} | {ratio_cell(r, 'volpath')} | {ratio_cell(r, 'mitsuba')} | {z_cell(r)} | "
                      f"{complete_cell(r)} | {ff} | {kind}, ±"
                      f"{fmt(100 * ref['se'] / max(abs(ref['mean']), 1e-30) if ref.get('se') is not None else None, 2)} %"
                      f"{factor} | {rm} |")
@@ -1126,6 +1251,20 @@ def report(args, P, mode, work, names, results, total, load):
                         f"overlapping intervals in {overlap} of {len(hv)}" +
                         (f" (not in {'; '.join(halves_note(n) for n in apart)})" if apart else ""))
     summary += " " + "; ".join(verdicts) + "."
+    seq = {n: results[n].get("sequential") for n in names if results[n].get("sequential")}
+    if seq:
+        cap = max(q["cap"] for q in seq.values())
+        ext = [f"{n} {q['runs']}" for n, q in seq.items() if q["runs"] > P["runs"]]
+        label = dict((k, l) for k, l, _ in METHODS)
+        low = [f"{n}: " + ", ".join(f"{label.get(m, m)} {fmt(results[n]['methods'].get(m, {}).get('n_eff_runs'))}"
+                                    for m in q["below_at_end"])
+               for n, q in seq.items() if q["below_at_end"]]
+        summary += (f" Runs: {P['runs']} per method, and batches of {P['runs']} more (up to {cap}) where a compared "
+                    f"method's V rested on fewer than {NEFF_MIN:g} effective runs (Kish): more runs in {len(ext)} of "
+                    f"{len(seq)} configurations" + (f" ({', '.join(ext)} runs)" if ext else "")
+                    if cap > P["runs"] else f" Runs: {P['runs']} per method (fixed: no more runs allowed)")
+        summary += (f"; below {NEFF_MIN:g} effective runs at the end (‡): {'; '.join(low)}." if low else
+                    f"; every compared method's V rests on ≥ {NEFF_MIN:g} effective runs.")
     vv = [(n, m, s["V_over_V_spread"]) for n in names for m, s in results[n]["methods"].items()
           if s.get("V_over_V_spread") and None not in s["V_over_V_spread"]]
     if vv:
@@ -1145,7 +1284,10 @@ def report(args, P, mode, work, names, results, total, load):
                              f"{c['sum_max_rel_diff']:.1e} |")
     text = [f"<!-- written by scripts/reproduce_figures.py --{mode}; do not edit -->", "", summary, "", table, "",
             "† the compared method fails the bias test there (it misses transport): its efficiency is that of an "
-            "estimate of a different integral.", ""]
+            "estimate of a different integral.", "",
+            f"‡ V of one of the two methods rests on fewer than {NEFF_MIN:g} effective runs (Kish: (Σ V_run)² / Σ "
+            "V_run²) after the sequential runs: one run carries more than a tenth of it, so the interval may still "
+            "depend on which seeds ran (JSON `n_eff_runs`, `sequential`).", ""]
     if cls_lines:
         missing = [n for n in names if not results[n].get("classes")]
         ok = sum(1 for d in diffs if d <= CLASS_SUM_TOL)
@@ -1185,7 +1327,8 @@ def report(args, P, mode, work, names, results, total, load):
                 fig4mi[key] = split(tonemap(z["avg_mitsuba"], e4), tonemap(z["avg_snee"], e4))
             e3 = exposure(z["f3_snee"])
             fig3[key] = split(tonemap(z["f3_forward"], e3), tonemap(z["f3_snee"], e3))
-    eq = f"{P['runs']} x {P['run_time']:g} s"
+    n_runs = sorted({results[n].get("runs", P["runs"]) for n in names})
+    eq = f"{'-'.join(str(k) for k in n_runs[::max(1, len(n_runs) - 1)])} x {P['run_time']:g} s"
     grid_png(os.path.join(out, "paper_fig3.png"), f"Figure 3: equal samples ({P['fig3_spp']} spp), SNEE's transport "
              "only - left: volpath (snee=forward), right: volpath_snee (MIS)", fig3,
              "each tile exposed by the 99th percentile of its SNEE half; sRGB")
@@ -1216,6 +1359,8 @@ def parser():
     ap.add_argument("--refs-only", action="store_true", help="render the references (and their rate probes) only")
     ap.add_argument("--force", action="store_true", help="recompute the configurations' results (renders stay cached)")
     ap.add_argument("--force-renders", action="store_true", help="render everything again")
+    ap.add_argument("--max-runs", type=int, default=None, help="cap of the sequential runs (default: the mode's; "
+                    "the mode's run count: the fixed design, e.g. a re-analysis of cached runs without new renders)")
     ap.add_argument("--no-mitsuba", action="store_true")
     ap.add_argument("--mitsuba-variant", default="auto", choices=["auto", "llvm_ad_rgb", "scalar_rgb"])
     ap.add_argument("--ray", action="store_true", help="run configurations as Ray tasks (default with --paper)")
@@ -1263,13 +1408,19 @@ def main():
           f"{'yes' if args.classes else 'not in this binary'}; V of every method, Mitsuba's too, from per-pixel "
           f"moments ({MI_V_NOTE}); load average {load0:.2f}", flush=True)
     smooth = [n for n in names if "_smooth_" in n]
-    est0, est1 = estimate_seconds(P, names, []), estimate_seconds(P, names, smooth)
+    cap = max(P["runs"], args.max_runs or P["max_runs"])
+    most = (cap - P["runs"]) // P["runs"]  # extension batches at the cap
+    batches = min(EXPECTED_BATCHES_PER_CONFIG, most)
+    est0, est1 = estimate_seconds(P, names, [], batches), estimate_seconds(P, names, smooth, batches)
     est_ref = missing_reference_seconds(P, args.refs, names)
     est0, est1 = est0 + est_ref, est1 + est_ref
     args.estimate = [est0, est1]
+    worst = estimate_seconds(P, names, smooth, most) + est_ref
     print(f"estimated wall time on an idle machine: {est0 / 60:.1f} min, {est1 / 60:.1f} min if `connection = "
           f"complete` differs from paper on the {len(smooth)} smooth configurations (of it {est_ref / 60:.1f} min "
-          f"for reference parts missing from {args.refs})", flush=True)
+          f"for reference parts missing from {args.refs}; with {batches:.2f} extension batches of {P['runs']} runs "
+          f"per configuration as in the committed run; {worst / 60:.1f} min if every configuration runs to the cap "
+          f"of {cap})", flush=True)
     pid_file = os.path.join(args.refs, "refs_only.pid")
     if not args.refs_only and os.path.exists(pid_file) and pid_alive(open(pid_file).read()):
         sys.exit(f"a --refs-only run (pid {open(pid_file).read().strip()}) is rendering into {args.refs}: wait for "
