@@ -43,6 +43,7 @@ pub mod newton_point;
 pub mod pdf;
 pub mod planes;
 pub mod rough;
+pub mod rough_finite;
 pub mod stage;
 pub mod track;
 
