@@ -32,9 +32,11 @@
 //! recomputes the connection's reference from the path's own `x_j`. Where the connection's density
 //! is 0 (outside its support, see docs/manifold.md §7.1) the others' weights sum to 1.
 //!
-//! Scope: directional lights and the environment (area and point lights through a rough boundary
-//! keep the paper's estimator: the connection contributes nothing for them, so its density is 0
-//! and their weights are unchanged); isotropic roughness.
+//! Scope: directional lights and the environment here; AREA lights at a finite distance (sphere,
+//! rectangle, mesh, disk) in [`rough_finite`](super::rough_finite) (docs/manifold.md §7.2), reached
+//! from [`sample`], [`nee_weight`], [`emitter_hit_weight`] and [`snee_weight`]; point and spot
+//! lights through a rough boundary keep the paper's estimator (the connection contributes nothing
+//! for them, so its density is 0 and their weights are unchanged); isotropic roughness.
 
 use super::planes::{MAX_PLANES, SAME_NORMAL};
 use super::{light_segment, MediumVertex};
@@ -423,8 +425,9 @@ fn connect(
 
 /// The manifold stage at a real scatter `v` inside the rough boundary `rb`: one emitter sample and,
 /// per orientation, one sampled refraction (a 1-D and a 2-D sample each, drawn whatever the light),
-/// each MIS-weighted ([`rough_weight`]). Only a directional light is connected; `None` when the
-/// depth budget leaves no room for `x_k` (then the connection does not run at `x_j`).
+/// each MIS-weighted ([`rough_weight`]). A directional light, the environment and area lights
+/// (`rough_finite::connect`) are connected; `None` when the depth budget leaves no room for `x_k`
+/// (then the connection does not run at `x_j`).
 pub fn sample(
     cx: &mut Cx,
     opts: SneeOptions,
@@ -493,7 +496,8 @@ pub fn sample(
 
 /// The weight of forward NEE at a rough `x_k` reached right after the medium vertex `x_j` (where the
 /// connection ran; `x_i`: the SNEE vertex just before `x_j`, if any) towards the emitter sample
-/// `ds`; `None` where the connection cannot make the path (the caller's weight stands).
+/// `ds` (an area light: `rough_finite::nee_weight`); `None` where the connection cannot make the
+/// path (the caller's weight stands).
 #[allow(clippy::too_many_arguments)]
 pub fn nee_weight(
     scene: &Scene,
@@ -528,8 +532,9 @@ pub fn nee_weight(
     Some(rough_weight(opts, RoughTechnique::FwdNee, p) as f32)
 }
 
-/// SNEE's weight for a suffix it made through a rough plane towards a directional light, or `None`
-/// (another light: SNEE's own weight stands).
+/// SNEE's weight for a suffix it made through a rough boundary towards a directional light, the
+/// environment or an area light (`rough_finite::snee_weight`), or `None` (another light: SNEE's
+/// own weight stands).
 pub fn snee_weight(
     scene: &Scene,
     technique: SneeTechnique,
