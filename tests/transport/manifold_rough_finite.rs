@@ -175,17 +175,17 @@ fn connection_density_integrates_to_its_success_probability() {
                 let u_light = rng.next_2d();
                 let Some(si_k) = s.ray_intersect(&Ray::new(p_j, omega_jk)) else { continue };
                 let sh = &s.shapes[si_k.shape as usize];
-                if sh.interior != Some(0) || !(omega_jk.dot(si_k.n) > 0.0) {
+                if sh.interior != Some(0) || omega_jk.dot(si_k.n) <= 0.0 {
                     continue;
                 }
                 let Some(plane) = plane_of(&s, &si_k) else { continue };
                 let (ds, w) = s.sample_emitter_direction(si_k.p, None, u_light, false);
-                if !(ds.pdf > 0.0) || w == snee::color::Spectrum::ZERO {
+                if ds.pdf <= 0.0 || w == snee::color::Spectrum::ZERO {
                     continue;
                 }
                 let Some(end) = rough_finite::end_of_sample(&s, &ds) else { continue };
                 let light = rough_finite::light_record(&s, &si_k, &end);
-                if !(end.n_y.dot(light.omega_l) < 0.0)
+                if end.n_y.dot(light.omega_l) >= 0.0
                     || light_transmission(&s, &si_k, &light, &mut stats) == snee::color::Spectrum::ZERO
                 {
                     continue;
