@@ -14,6 +14,7 @@ mod manifold_oblique;
 mod manifold_options;
 mod manifold_rough;
 mod manifold_rough_curved;
+mod manifold_rough_finite;
 mod manifold_slab;
 mod manifold_unbiased;
 mod snee_degenerate;

@@ -19,7 +19,8 @@
 //! suffixes with SNEE; under an environment or an area light it also shares them with forward
 //! tracing ([`mis`]). Lights at a finite distance: [`finite`]. Scope (docs/manifold.md §6):
 //! boundaries made of flat facets ([`flat`]); ROUGH boundaries, flat or curved, under a
-//! directional light or an environment ([`rough`], §7); curved smooth boundaries under a
+//! directional light or an environment ([`rough`], §7) and under area lights ([`rough_finite`],
+//! §7.2); curved smooth boundaries under a
 //! directional light ([`curved`], Newton and specular manifold sampling in [`newton`], §8) and
 //! under area and sphere lights ([`curved_finite`], [`newton_point`], §8.2); with
 //! `reflection_chains`, two-vertex chains under a directional light ([`chain`], §9); elsewhere
@@ -43,6 +44,7 @@ pub mod newton_point;
 pub mod pdf;
 pub mod planes;
 pub mod rough;
+pub mod rough_finite;
 pub mod stage;
 pub mod track;
 

@@ -32,9 +32,11 @@
 //! recomputes the connection's reference from the path's own `x_j`. Where the connection's density
 //! is 0 (outside its support, see docs/manifold.md §7.1) the others' weights sum to 1.
 //!
-//! Scope: directional lights and the environment (area and point lights through a rough boundary
-//! keep the paper's estimator: the connection contributes nothing for them, so its density is 0
-//! and their weights are unchanged); isotropic roughness.
+//! Scope: directional lights and the environment here; AREA lights at a finite distance (sphere,
+//! rectangle, mesh, disk) in [`rough_finite`](super::rough_finite) (docs/manifold.md §7.2), reached
+//! from [`sample`], [`nee_weight`], [`emitter_hit_weight`] and [`snee_weight`]; point and spot
+//! lights through a rough boundary keep the paper's estimator (the connection contributes nothing
+//! for them, so its density is 0 and their weights are unchanged); isotropic roughness.
 
 use super::planes::{MAX_PLANES, SAME_NORMAL};
 use super::{light_segment, MediumVertex};
@@ -172,7 +174,7 @@ pub fn curved_reference(
 }
 
 /// Refinement steps of [`curved_reference`] (each one ray at every evaluation of the density).
-const REFINE_STEPS: usize = 2;
+pub(super) const REFINE_STEPS: usize = 2;
 
 /// The reference in which the connection at `x_j` would have sampled a suffix towards `omega_l`
 /// whose boundary point is on `plane` (flat) or anywhere on a curved boundary (`plane = None`).
@@ -248,7 +250,7 @@ pub fn pdf_inner_in(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, omega_jk: Vec3) ->
 }
 
 /// Is `si` (hit from inside `medium` along `d`) on the orientation `plane` of its rough boundary?
-fn on_plane(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3, plane: &RoughPlane) -> bool {
+pub(super) fn on_plane(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3, plane: &RoughPlane) -> bool {
     let s = &scene.shapes[si.shape as usize];
     s.interior == Some(medium)
         && s.exterior.is_none()
@@ -258,7 +260,7 @@ fn on_plane(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3, plane:
 }
 
 /// Is `si` (hit along `d`) a point of `medium`'s enclosing rough boundary, met from inside?
-fn on_boundary(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3) -> bool {
+pub(super) fn on_boundary(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3) -> bool {
     let s = &scene.shapes[si.shape as usize];
     s.interior == Some(medium)
         && s.exterior.is_none()
@@ -423,8 +425,9 @@ fn connect(
 
 /// The manifold stage at a real scatter `v` inside the rough boundary `rb`: one emitter sample and,
 /// per orientation, one sampled refraction (a 1-D and a 2-D sample each, drawn whatever the light),
-/// each MIS-weighted ([`rough_weight`]). Only a directional light is connected; `None` when the
-/// depth budget leaves no room for `x_k` (then the connection does not run at `x_j`).
+/// each MIS-weighted ([`rough_weight`]). A directional light, the environment and area lights
+/// (`rough_finite::connect`) are connected; `None` when the depth budget leaves no room for `x_k`
+/// (then the connection does not run at `x_j`).
 pub fn sample(
     cx: &mut Cx,
     opts: SneeOptions,
@@ -444,6 +447,12 @@ pub fn sample(
         && !ds.dist.is_finite()
         && weight != Spectrum::ZERO
         && (ds.delta || scene.environment == Some(ds.emitter));
+    // An area light at a finite distance: `rough_finite.rs` (docs/manifold.md §7.2).
+    let area = ds.pdf > 0.0
+        && ds.dist.is_finite()
+        && !ds.delta
+        && weight != Spectrum::ZERO
+        && super::rough_finite::is_area(scene, ds.emitter);
     let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
     let light =
         LightSample { omega_l: ds.d, p: ds.p, dist: ds.dist, p_light: ds.pdf, delta: ds.delta, le: Spectrum::ZERO };
@@ -452,6 +461,13 @@ pub fn sample(
     // frame found from x_j (docs/manifold.md §7.1).
     for plane in rb.planes.iter().map(Some).chain(rb.curved.then_some(None)) {
         let (u1, u2) = (sampler.next_1d(), sampler.next_2d());
+        if area {
+            let c = super::rough_finite::connect(scene, opts, x_i, &x_j, plane, &ds, (u1, u2), channel, stats);
+            if let Some(c) = c {
+                super::add_finite(&mut result, v.beta * c.value, stats);
+            }
+            continue;
+        }
         if !distant {
             continue;
         }
@@ -480,7 +496,8 @@ pub fn sample(
 
 /// The weight of forward NEE at a rough `x_k` reached right after the medium vertex `x_j` (where the
 /// connection ran; `x_i`: the SNEE vertex just before `x_j`, if any) towards the emitter sample
-/// `ds`; `None` where the connection cannot make the path (the caller's weight stands).
+/// `ds` (an area light: `rough_finite::nee_weight`); `None` where the connection cannot make the
+/// path (the caller's weight stands).
 #[allow(clippy::too_many_arguments)]
 pub fn nee_weight(
     scene: &Scene,
@@ -492,7 +509,8 @@ pub fn nee_weight(
     channel: usize,
     stats: &mut LocalStats,
 ) -> Option<f32> {
-    if ds.dist.is_finite() || !(ds.delta || scene.environment == Some(ds.emitter)) {
+    let area = ds.dist.is_finite() && !ds.delta;
+    if !area && (ds.dist.is_finite() || !(ds.delta || scene.environment == Some(ds.emitter))) {
         return None;
     }
     let rb = boundary_of(scene, x_j.medium)?;
@@ -500,6 +518,10 @@ pub fn nee_weight(
     let omega_jk = -si_k.to_world(si_k.wi).normalize();
     let d_jk = (si_k.p - x_j.p).length();
     let plane = locate(scene, rb, si_k, x_j.medium, omega_jk)?;
+    if area {
+        let path = (si_k, omega_jk, d_jk);
+        return super::rough_finite::nee_weight(scene, opts, x_i, x_j, plane.as_ref(), path, ds, channel, stats);
+    }
     if light_segment(scene, si_k, ds.d, stats) == Spectrum::ZERO {
         return None;
     }
@@ -510,8 +532,9 @@ pub fn nee_weight(
     Some(rough_weight(opts, RoughTechnique::FwdNee, p) as f32)
 }
 
-/// SNEE's weight for a suffix it made through a rough plane towards a directional light, or `None`
-/// (another light: SNEE's own weight stands).
+/// SNEE's weight for a suffix it made through a rough boundary towards a directional light, the
+/// environment or an area light (`rough_finite::snee_weight`), or `None` (another light: SNEE's
+/// own weight stands).
 pub fn snee_weight(
     scene: &Scene,
     technique: SneeTechnique,
@@ -520,13 +543,17 @@ pub fn snee_weight(
     light: &LightSample,
     channel: usize,
 ) -> Option<f64> {
-    if light.dist.is_finite() || !(light.delta || scene.environment.is_some()) {
+    let area = light.dist.is_finite() && !light.delta;
+    if !area && (light.dist.is_finite() || !(light.delta || scene.environment.is_some())) {
         return None;
     }
     let si_k = &s.si_k;
     let v_jk = si_k.p - s.x_j;
     let d_jk = v_jk.length();
     let plane = locate(scene, rb, si_k, s.x_i.medium, v_jk / d_jk)?;
+    if area {
+        return super::rough_finite::snee_weight(scene, technique, plane.as_ref(), s, light, channel);
+    }
     let v_ij = s.x_j - s.x_i.p;
     let t_ij = v_ij.length();
     if !(t_ij > 0.0) {
@@ -568,6 +595,25 @@ pub fn pending(
     let omega_jk = -s.to_world(s.wi);
     let plane = locate(scene, rb, s, x_j.medium, omega_jk)?;
     Some(RoughPending { x_i, x_j, si_k: *s, plane })
+}
+
+/// The weight of forward BSDF sampling for a path that left through the rough boundary right after
+/// `x_j` (`rp`) and reached an emitter along `omega_l`: the environment (`hit = None`,
+/// [`bsdf_hit_weight`]) or an area light at `hit` (`rough_finite::bsdf_hit_weight`); `None` where
+/// the connection does not share the path.
+pub fn emitter_hit_weight(
+    scene: &Scene,
+    opts: SneeOptions,
+    rp: &RoughPending,
+    hit: Option<&SurfaceInteraction>,
+    omega_l: Vec3,
+    channel: usize,
+    stats: &mut LocalStats,
+) -> Option<f32> {
+    match hit {
+        None => bsdf_hit_weight(scene, opts, rp, omega_l, channel, stats),
+        Some(y) => super::rough_finite::bsdf_hit_weight(scene, opts, rp, y, channel, stats),
+    }
 }
 
 /// The weight of forward BSDF sampling for a path that left through a rough plane right after `x_j`

@@ -110,11 +110,9 @@ impl<'a> ManifoldStage<'a> {
         stats: &mut LocalStats,
     ) -> Option<f32> {
         if let Some(rp) = &self.rough_arrived {
-            // Through a rough plane: only an escape to the environment is shared.
-            return match self.hit {
-                None => super::rough::bsdf_hit_weight(scene, self.snee.options, rp, d, channel, stats),
-                Some(_) => None,
-            };
+            // Through a rough boundary: an escape to the environment or an area-light hit.
+            let hit = self.hit.as_ref();
+            return super::rough::emitter_hit_weight(scene, self.snee.options, rp, hit, d, channel, stats);
         }
         if let (Some(cp), Some(y)) = (&self.curved_arrived, &self.hit) {
             return curved_finite::forward_weight(scene, self.snee.options, cp, y, d, channel, stats);
