@@ -8,7 +8,9 @@ mod common;
 
 mod manifold_chain;
 mod manifold_curved;
+mod manifold_curved_cone;
 mod manifold_curved_finite;
+mod manifold_curved_statue;
 mod manifold_finite;
 mod manifold_oblique;
 mod manifold_options;

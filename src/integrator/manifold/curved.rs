@@ -78,6 +78,21 @@ fn curved_boundary(scene: &Scene, medium: u32) -> bool {
     enclosed
 }
 
+/// The largest relative index `η = η_int / η_ext` of the smooth dielectrics enclosing `medium`
+/// (where the connection applies, every enclosing shape is one): bounds how far a solution turns
+/// from the light's direction ([`newton::max_turn`]).
+pub fn largest_eta(scene: &Scene, medium: u32) -> f64 {
+    scene
+        .shapes
+        .iter()
+        .filter(|s| s.interior == Some(medium) && s.exterior.is_none())
+        .filter_map(|s| match &scene.bsdfs[s.bsdf as usize] {
+            Bsdf::Dielectric(d) => Some(d.eta as f64),
+            _ => None,
+        })
+        .fold(0.0, f64::max)
+}
+
 /// A verified connection: its value (without the path throughput and the MIS weight) and `x_k`.
 #[derive(Clone, Copy, Debug)]
 pub struct CurvedConnection {
@@ -101,7 +116,8 @@ pub fn connect(
     let mut locate = SceneLocate { scene, medium: x_j.medium, rays: 0 };
     let mut counts = newton::SolveCounts::default();
     let mut u = || sampler.next_1d() as f64;
-    let sampled = newton::sample_solution(&mut locate, x_j.p.as_dvec3(), omega_l.as_dvec3(), &mut u, &mut counts);
+    let turn = newton::max_turn(largest_eta(scene, x_j.medium));
+    let sampled = newton::sample_solution(&mut locate, x_j.p.as_dvec3(), omega_l.as_dvec3(), turn, &mut u, &mut counts);
     stats.rays += locate.rays;
     stats.manifold_newton_solves += counts.solves;
     stats.manifold_newton_iterations += counts.iterations;
@@ -112,8 +128,23 @@ pub fn connect(
         stats.manifold_failures += 1;
         return None;
     };
-    // Verify in the renderer's own precision: the first hit along the solution is x_k, on the
-    // enclosing boundary from inside; the light leaves outside both normals there.
+    value(scene, x_j, &sol, omega_l, weight, trials as f64, stats)
+}
+
+/// Verify a Newton solution `sol` from `x_j` towards `omega_l` in the renderer's own precision
+/// (the first hit along it is `x_k`, on the enclosing boundary from inside, with the solved
+/// shading normal; the light leaves outside both normals there; the light segment is passable)
+/// and return its value `f(s)` times `scale` (the caller's estimate of `1/p(s)`). Counts the
+/// connection as a solution or a failure.
+pub fn value(
+    scene: &Scene,
+    x_j: &MediumVertex,
+    sol: &newton::Solution,
+    omega_l: Vec3,
+    weight: Spectrum,
+    scale: f64,
+    stats: &mut LocalStats,
+) -> Option<CurvedConnection> {
     let omega = sol.omega.as_vec3().normalize();
     stats.rays += 1;
     let verified = scene.ray_intersect(&Ray::new(x_j.p, omega)).filter(|si| {
@@ -132,8 +163,7 @@ pub fn connect(
     let eta = sol.patch.eta as f32;
     let f = fresnel(sol.refracted.cos_out as f32, eta).0;
     let spread = ((1.0 - f) * eta * eta) as f64 * sol.d_omega_d_omega_l;
-    let value =
-        m.phase.eval(x_j.wi, omega) * m.transmittance(si_k.t) * tr_out * weight * (spread * trials as f64) as f32;
+    let value = m.phase.eval(x_j.wi, omega) * m.transmittance(si_k.t) * tr_out * weight * (spread * scale) as f32;
     Some(CurvedConnection { value, si_k, omega })
 }
 

@@ -35,6 +35,7 @@ use crate::integrator::stats::LocalStats;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::{Ray, Vec3};
 use crate::scene::world::{Scene, SceneEmitter};
+use crate::shape::Geometry;
 
 /// Probability that the connection runs at a medium vertex whose emitter sample picked an area
 /// light (a constant, part of its density everywhere): each connection costs a Newton solve
@@ -127,6 +128,24 @@ fn pdfs(
     )
 }
 
+/// The light's normal at its point `y` as every technique here evaluates it (the connection, a
+/// forward hit, SNEE's sample): on an analytic sphere, `(y − center)/radius` (times −1 with
+/// `flip_normals`) computed from `y` itself, so that all three weigh the same suffix with the same
+/// `cos θ_y` (SNEE's light record carries no normal, and the normal of an f32 ray hit near `y`
+/// differs from the sampled one by enough to move `p_man` by ~1.5 % at grazing `θ_y`); elsewhere
+/// (rectangles, meshes: a flat triangle's normal does not depend on where on it `y` lies) the
+/// given normal `n`.
+pub fn light_normal(scene: &Scene, shape: u32, y: Vec3, n: Vec3) -> Vec3 {
+    match &scene.shapes[shape as usize].geometry {
+        Geometry::Sphere(sp) => {
+            let d = (y.as_dvec3() - sp.center.as_dvec3()).normalize();
+            let d = if sp.flip_normals { -d } else { d };
+            d.as_vec3()
+        }
+        _ => n,
+    }
+}
+
 /// Does the light's front at `y` (normal `n_y`) face `x_j`? The connection solves only then (a
 /// function of `(x_j, y)`, part of its density: saves the solves towards the back half of a sphere
 /// light; the few suffixes near the silhouette it excludes are forward tracing's and SNEE's).
@@ -193,9 +212,11 @@ pub fn connect(
         stats.manifold_failures += 1;
         None
     };
-    let (Some((n_y, uv)), SceneEmitter::Area { radiance, .. }) = (lp.area, &scene.emitters[lp.emitter as usize]) else {
+    let (Some((n_y, uv)), SceneEmitter::Area { radiance, shape, .. }) = (lp.area, &scene.emitters[lp.emitter as usize])
+    else {
         return None;
     };
+    let n_y = light_normal(scene, *shape, lp.y, n_y);
     if !faces(n_y, lp.y, x_j.p) {
         return fail(stats);
     }
@@ -300,9 +321,11 @@ pub fn forward_weight(
     stats: &mut LocalStats,
 ) -> Option<f32> {
     scene.shapes[y.shape as usize].emitter?;
-    let (p_y, cos_y) = finite::area_point_density(scene, y, omega_l);
+    let (p_y, _) = finite::area_point_density(scene, y, omega_l);
+    let n_y = light_normal(scene, y.shape, y.p, y.n);
+    let cos_y = n_y.dot(omega_l).abs();
     let d_jk = (p.si_k.p - p.x_j.p).length();
-    let p_man = density(scene, &p.x_j, p.omega_jk, y.p, y.n, p_y, cos_y, stats);
+    let p_man = density(scene, &p.x_j, p.omega_jk, y.p, n_y, p_y, cos_y, stats);
     let ds = scene.direction_sample_for_hit(p.si_k.p, y);
     let light = LightSample::hit(omega_l, y.p, ds.dist, scene.pdf_emitter_direction(p.si_k.p, &ds));
     let pd = pdfs(scene, opts, p.x_i.as_ref(), &p.x_j, &p.si_k, p.omega_jk, d_jk, &light, p_man, channel, true, stats);
@@ -325,13 +348,16 @@ pub fn snee_weight(
     let opts = SneeOptions { technique, ..scene.integrator.snee };
     let mut no_stats = LocalStats::default();
     let hit = finite::area_point_hit(scene, &s.si_k, light.omega_l)?;
-    let (p_y, cos_y) = finite::area_point_density(scene, &hit, light.omega_l);
+    let (p_y, _) = finite::area_point_density(scene, &hit, light.omega_l);
+    // The normal at SNEE's own light point, not at the f32 hit ([`light_normal`]).
+    let n_y = light_normal(scene, hit.shape, light.p, hit.n);
+    let cos_y = n_y.dot(light.omega_l).abs();
     let v_ij = s.x_j - s.x_i.p;
     let x_j = MediumVertex { p: s.x_j, wi: -v_ij / v_ij.length(), medium: s.x_i.medium };
     let v_jk = s.si_k.p - s.x_j;
     let d_jk = v_jk.length();
     let omega_jk = v_jk / d_jk;
-    let p_man = density(scene, &x_j, omega_jk, light.p, hit.n, p_y, cos_y, &mut no_stats);
+    let p_man = density(scene, &x_j, omega_jk, light.p, n_y, p_y, cos_y, &mut no_stats);
     let p = pdfs(scene, opts, Some(&s.x_i), &x_j, &s.si_k, omega_jk, d_jk, light, p_man, channel, false, &mut no_stats);
     Some(mis::env_weight(opts, EnvTechnique::Snee, p))
 }

@@ -182,10 +182,16 @@ pub fn damped_step<T>(
 /// Specular manifold sampling's Bernoulli trials (Zeltner et al. 2020, §4.3) after a first solution
 /// `omega`: draw solutions until one equal to it comes back. The number of draws `n` (counting the
 /// first) has `E[n] = 1/p`; returns `(n, capped)`, `capped` when [`MAX_TRIALS`] stopped it.
-pub fn bernoulli_trials(omega: DVec3, mut draw: impl FnMut() -> Option<DVec3>) -> (u32, bool) {
+pub fn bernoulli_trials(omega: DVec3, draw: impl FnMut() -> Option<DVec3>) -> (u32, bool) {
+    bernoulli_trials_capped(omega, MAX_TRIALS, draw)
+}
+
+/// [`bernoulli_trials`] with the cap `cap`: `E[min(n, cap) | p] = (1 − (1 − p)^cap) / p`, so a
+/// solution of probability `p` is under-counted by the factor `1 − (1 − p)^cap ≥ 1 − e^{−p cap}`.
+pub fn bernoulli_trials_capped(omega: DVec3, cap: u32, mut draw: impl FnMut() -> Option<DVec3>) -> (u32, bool) {
     let mut n = 1;
     loop {
-        if n >= MAX_TRIALS {
+        if n >= cap {
             return (n, true);
         }
         match draw() {
@@ -297,13 +303,23 @@ pub fn solve(locate: &mut impl Locate, x_j: DVec3, omega_l: DVec3, seed: DVec3) 
     Err((Failure::NoConvergence, MAX_ITERATIONS))
 }
 
-/// Largest number of Bernoulli trials in [`sample_solution`] (SMS's cap; beyond it the estimate of
-/// `1/p` is truncated, a bias bounded by `(1 − p)^CAP` of that solution's contribution).
+/// Largest number of Bernoulli trials of the two-vertex chains (`chain.rs`; SMS's cap: beyond it
+/// the estimate of `1/p` is truncated, a bias bounded by `(1 − p)^CAP` of that solution's
+/// contribution).
 pub const MAX_TRIALS: u32 = 64;
+/// Largest number of Bernoulli trials in [`sample_solution`] (the one-refraction connection under
+/// a directional light, docs/manifold.md §8.1): a solution of probability `p` keeps the share
+/// `1 − (1 − p)^CAP` of its contribution (above `1 − 1.6e-7` for `p ≥ 1/256`). The expected number
+/// of draws per connection does not depend on the cap beyond `1 + (number of solutions)` (each
+/// solution `s` is drawn first with probability `p(s)` and then costs `1/p(s)` draws).
+pub const DIRECTIONAL_MAX_TRIALS: u32 = 4096;
 /// Two solutions are the same when their directions differ by less than this (radians).
 const SAME_SOLUTION: f64 = 1e-4;
-/// Probability of the deterministic seed ([`refracted_seed`]) in the seed mixture.
-const P_DETERMINISTIC: f64 = 0.5;
+/// Probability of the deterministic seed ([`refracted_seed`]) in the seed mixture, when its solve
+/// converged (else 0: the mixture is chosen after that one solve, a function of `(x_j, omega_l)`).
+const P_DETERMINISTIC: f64 = 0.25;
+/// Probability, among the random seeds, of the refracted random seed ([`random_seed`]).
+pub const P_REFRACTED_RANDOM: f64 = 0.5;
 
 /// Statistics of one [`sample_solution`] call (for `--stats`).
 #[derive(Clone, Copy, Debug, Default)]
@@ -340,51 +356,94 @@ pub fn sphere_seed(u1: f64, u2: f64) -> DVec3 {
     DVec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
-/// A direction uniform on the hemisphere around `omega_l` (every refraction solution lies there:
-/// the refracted ray turns by less than 90°).
-fn hemisphere_seed(omega_l: DVec3, u1: f64, u2: f64) -> DVec3 {
-    let z = u1;
+/// The largest angle between a refraction solution `omega` and `omega_l` through interfaces of
+/// relative index at most `eta_max` (`η = η_int / η_ext`): the light turns by `θ_l − θ_in`, largest
+/// at grazing incidence, `π/2 − asin(1/η)` for `η > 1`; `π/2` otherwise (a refracted ray turns by
+/// less than 90°).
+pub fn max_turn(eta_max: f64) -> f64 {
+    if eta_max > 1.0 {
+        std::f64::consts::FRAC_PI_2 - (1.0 / eta_max).asin()
+    } else {
+        std::f64::consts::FRAC_PI_2
+    }
+}
+
+/// A direction uniform in the cone of half-angle `turn` around `omega_l`.
+pub fn cone_seed(omega_l: DVec3, turn: f64, u1: f64, u2: f64) -> DVec3 {
+    let z = 1.0 - u1 * (1.0 - turn.cos());
     let r = (1.0 - z * z).max(0.0).sqrt();
     let phi = std::f64::consts::TAU * u2;
     let (t1, t2) = tangents(omega_l);
     (t1 * (r * phi.cos()) + t2 * (r * phi.sin()) + omega_l * z).normalize()
 }
 
-/// Specular manifold sampling's unbiased estimate (Zeltner, Georgiev, Jakob 2020, §4.3): one
-/// solution `s` from a random seed, and the number `N` of seeds drawn until `s` is found again
-/// (`E[N | s] = 1/p(s)`, capped at [`MAX_TRIALS`]). `f(s) · N` is then an unbiased estimate of
-/// `Σ_s f(s)` over all solutions whatever their number. Seeds: with probability 1/2 the
-/// deterministic [`refracted_seed`] (solved once and reused), else uniform on the hemisphere
-/// around `omega_l`, so every solution has a positive probability and the one the deterministic
-/// seed finds has `p ≥ 1/2`. `u` supplies uniform numbers in [0, 1).
+/// One random seed of [`sample_solution`]: a direction `w` uniform in the cone of half-angle
+/// `turn` around `omega_l` (every solution lies there, [`max_turn`]); with probability
+/// `p_refracted`, `w` is then replaced by the reverse of `omega_l` refracted about the shading
+/// normal where `w` meets the boundary (a random boundary point's own "refracted seed", as
+/// [`refracted_seed`] is the straight line's; `w` itself when that fails). Every direction of the
+/// cone keeps a positive density (the uniform part), so every solution a seed in its basin of
+/// convergence reaches has a positive probability.
+pub fn random_seed(
+    locate: &mut impl Locate,
+    x_j: DVec3,
+    omega_l: DVec3,
+    turn: f64,
+    p_refracted: f64,
+    u: &mut dyn FnMut() -> f64,
+) -> DVec3 {
+    let refracted = u() < p_refracted;
+    let w = cone_seed(omega_l, turn, u(), u());
+    if !refracted {
+        return w;
+    }
+    let Some(patch) = locate.locate(x_j, w) else { return w };
+    let Some((_, _, n_s)) = patch.hit(x_j, w) else { return w };
+    let cos_l = omega_l.dot(n_s);
+    if !(cos_l > 0.0) {
+        return w;
+    }
+    let tangential = (omega_l - n_s * cos_l) / patch.eta;
+    let cos_in = (1.0 - tangential.length_squared()).max(0.0).sqrt();
+    (tangential + n_s * cos_in).normalize()
+}
+
+/// Specular manifold sampling's estimate (Zeltner, Georgiev, Jakob 2020, §4.3): one solution `s`
+/// from a random seed, and the number `N` of seeds drawn until `s` is found again
+/// (`E[N | s] = 1/p(s)`, capped at [`DIRECTIONAL_MAX_TRIALS`]). `f(s) · N` is then an estimate of
+/// `Σ_s f(s)` over all solutions whatever their number. The seed distribution is a function of
+/// `(x_j, omega_l)` only: the deterministic [`refracted_seed`] is solved first; when it converged,
+/// each draw takes it with probability [`P_DETERMINISTIC`] (solved once, reused), else a
+/// [`random_seed`] in the cone of half-angle `turn` ([`max_turn`] of the boundary's largest
+/// index), so every solution has a positive probability. `u` supplies uniform numbers in [0, 1).
 pub fn sample_solution(
     locate: &mut impl Locate,
     x_j: DVec3,
     omega_l: DVec3,
+    turn: f64,
     u: &mut impl FnMut() -> f64,
     counts: &mut SolveCounts,
 ) -> Option<(Solution, u32)> {
     let omega_l = omega_l.normalize();
-    let mut deterministic: Option<Option<Solution>> = None;
-    let mut draw = |locate: &mut _, u: &mut dyn FnMut() -> f64, counts: &mut SolveCounts| -> Option<Solution> {
-        if u() < P_DETERMINISTIC {
-            if deterministic.is_none() {
-                let r = refracted_seed(locate, x_j, omega_l)
-                    .ok_or((Failure::Lost, 0))
-                    .and_then(|seed| solve(locate, x_j, omega_l, seed));
-                counts.count(&r);
-                deterministic = Some(r.ok());
-            }
-            deterministic.unwrap()
+    let det = refracted_seed(locate, x_j, omega_l)
+        .ok_or((Failure::Lost, 0))
+        .and_then(|seed| solve(locate, x_j, omega_l, seed));
+    counts.count(&det);
+    let deterministic = det.ok();
+    let p_det = if deterministic.is_some() { P_DETERMINISTIC } else { 0.0 };
+    let draw = |locate: &mut _, u: &mut dyn FnMut() -> f64, counts: &mut SolveCounts| -> Option<Solution> {
+        if u() < p_det {
+            deterministic
         } else {
-            let seed = hemisphere_seed(omega_l, u(), u());
+            let seed = random_seed(locate, x_j, omega_l, turn, P_REFRACTED_RANDOM, u);
             let r = solve(locate, x_j, omega_l, seed);
             counts.count(&r);
             r.ok()
         }
     };
     let s = draw(locate, u, counts)?;
-    let (n, capped) = bernoulli_trials(s.omega, || draw(locate, u, counts).map(|t| t.omega));
+    let (n, capped) =
+        bernoulli_trials_capped(s.omega, DIRECTIONAL_MAX_TRIALS, || draw(locate, u, counts).map(|t| t.omega));
     counts.capped += capped as u64;
     Some((s, n))
 }
@@ -502,6 +561,53 @@ pub(super) mod tests {
     }
 }
 
+/// The Bernoulli trials' count against its known expectation: a draw returns the first solution
+/// with probability `p`, so `E[min(N, cap)] = (1 − (1 − p)^cap) / p` (`1/p` up to `e^{−p cap}`).
+/// 200 000 runs per case, chosen before the first run; within 5 standard errors.
+#[cfg(test)]
+mod trials {
+    use super::*;
+
+    #[test]
+    fn bernoulli_count_has_expectation_one_over_p() {
+        let mut rng = crate::sampler::Sampler::new(3, 1);
+        let mut u = move || rng.next_1d() as f64;
+        for (p, cap) in
+            [(0.5, DIRECTIONAL_MAX_TRIALS), (0.01, DIRECTIONAL_MAX_TRIALS), (0.001, DIRECTIONAL_MAX_TRIALS), (0.1, 8)]
+        {
+            let runs = 200_000;
+            let (mut s, mut s2) = (0.0, 0.0);
+            for _ in 0..runs {
+                let (n, _) = bernoulli_trials_capped(DVec3::X, cap, || Some(if u() < p { DVec3::X } else { DVec3::Y }));
+                s += n as f64;
+                s2 += (n as f64) * (n as f64);
+            }
+            let mean = s / runs as f64;
+            let se = ((s2 / runs as f64 - mean * mean) / runs as f64).sqrt();
+            let expected = (1.0 - (1.0 - p).powi(cap as i32)) / p;
+            assert!((mean - expected).abs() < 5.0 * se, "p {p} cap {cap}: {mean} ± {se} vs {expected}");
+        }
+    }
+
+    /// The cone seeds stay within `max_turn` of `omega_l` and fill it uniformly in `cos`.
+    #[test]
+    fn cone_seeds_fill_the_cone() {
+        let omega_l = DVec3::new(0.3, -0.5, 0.8).normalize();
+        let turn = max_turn(1.5);
+        let mut rng = crate::sampler::Sampler::new(4, 1);
+        let mut below = 0;
+        let n = 100_000;
+        let mid = 0.5 * (1.0 + turn.cos());
+        for _ in 0..n {
+            let w = cone_seed(omega_l, turn, rng.next_1d() as f64, rng.next_1d() as f64);
+            assert!(w.dot(omega_l) >= turn.cos() - 1e-12);
+            below += (w.dot(omega_l) < mid) as u32;
+        }
+        let frac = below as f64 / n as f64;
+        assert!((frac - 0.5).abs() < 5.0 * (0.25 / n as f64).sqrt(), "{frac}");
+    }
+}
+
 /// On a glass ball (n = 1.5) the refracted beam overlaps itself (rays from opposite sides of the
 /// axis cross, and the caustic), so a point `x_j` can have several solutions: at random `x_j`
 /// (uniform in the ball) and light directions, every solution is collected from 256 random seeds,
@@ -563,7 +669,7 @@ mod coverage {
             deterministic += det.map_or(0.0, |s| weight(&s));
             // Per point: the SMS estimate's error against the exact sum.
             for _ in 0..256 {
-                let e = sample_solution(&mut Ball, x_j, omega_l, &mut u, &mut counts)
+                let e = sample_solution(&mut Ball, x_j, omega_l, max_turn(1.5), &mut u, &mut counts)
                     .map_or(0.0, |(s, n)| weight(&s) * n as f64);
                 sms_sum += e - exact;
                 sms_sq += (e - exact) * (e - exact);
