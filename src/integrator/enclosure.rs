@@ -65,6 +65,17 @@ fn unreachable(scene: &Scene, medium: u32) -> bool {
     others_ok && emitters_ok
 }
 
+/// True when no shape's BSDF lets a shadow ray through: none is `null`, `thindielectric` or `mask`
+/// (the BSDFs whose `eval_null_transmission` can be non-zero) and none has a null lobe. Then a
+/// shadow ray ends at the first surface it meets, so its transmittance needs only an any-hit query
+/// (`volpath::shadow_transmittance`).
+pub fn surfaces_block_shadow_rays(scene: &Scene) -> bool {
+    scene.shapes.iter().all(|s| {
+        let b = &scene.bsdfs[s.bsdf as usize];
+        !matches!(b, Bsdf::Null | Bsdf::ThinDielectric(_) | Bsdf::Mask(_)) && b.flags() & flags::NULL == 0
+    })
+}
+
 /// Do the boxes share a point?
 fn overlaps(a: &Aabb, b: &Aabb) -> bool {
     a.min.cmple(b.max).all() && b.min.cmple(a.max).all()

@@ -45,6 +45,9 @@ pub struct Scene {
     pub bounds: Aabb,
     /// Per medium: emitter sampling from inside it always returns 0 (`integrator/enclosure.rs`).
     pub emitters_unreachable: Vec<bool>,
+    /// No surface lets a shadow ray through (no null, thindielectric or mask BSDF): shadow-ray
+    /// transmittance needs one any-hit query (`integrator/enclosure.rs`).
+    pub surfaces_block_shadow_rays: bool,
 }
 
 impl Scene {
