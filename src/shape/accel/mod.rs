@@ -127,7 +127,6 @@ impl Accel {
     }
 
     /// Closest hit along the ray in (0, ray.tmax).
-    #[inline]
     pub fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
         // A NaN or infinite ray has no hit; the traversal's nearest-first order needs finite distances.
         if !ray_is_finite(ray) {
@@ -139,7 +138,6 @@ impl Accel {
     }
 
     /// True when anything blocks the ray in (0, ray.tmax).
-    #[inline]
     pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
         // A NaN or infinite ray carries no light: report it blocked.
         if !ray_is_finite(ray) {
