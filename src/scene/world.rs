@@ -54,7 +54,7 @@ impl Scene {
     /// Closest surface hit.
     #[inline]
     pub fn ray_intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let hit = self.accel.intersect(&self.shapes, ray)?;
+        let hit = self.accel.intersect_inline(&self.shapes, ray)?;
         let mut si = self.shapes[hit.shape as usize].interaction(hit.prim, hit.b1, hit.b2, hit.t, ray);
         si.shape = hit.shape;
         Some(si)
@@ -63,7 +63,7 @@ impl Scene {
     /// True when the segment is blocked.
     #[inline]
     pub fn ray_test(&self, ray: &Ray) -> bool {
-        self.accel.occluded(&self.shapes, ray)
+        self.accel.occluded_inline(&self.shapes, ray)
     }
 
     /// The BSDF of the shape that was hit.

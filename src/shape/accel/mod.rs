@@ -126,8 +126,20 @@ impl Accel {
         self.bvh.as_ref().map_or((0, 0, 0), |b| (b.nodes.len(), b.packets.len(), b.depth))
     }
 
-    /// Closest hit along the ray in (0, ray.tmax).
+    /// Closest hit along the ray in (0, ray.tmax): [`Accel::intersect_inline`] as a call of its own
+    /// (benchmarks and tests count its instructions; the renderer inlines the query).
     pub fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
+        self.intersect_inline(shapes, ray)
+    }
+
+    /// True when anything blocks the ray in (0, ray.tmax): [`Accel::occluded_inline`] as a call.
+    pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
+        self.occluded_inline(shapes, ray)
+    }
+
+    /// Closest hit along the ray in (0, ray.tmax), inlined into the caller (`Scene::ray_intersect`).
+    #[inline(always)]
+    pub fn intersect_inline(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
         // A NaN or infinite ray has no hit; the traversal's nearest-first order needs finite distances.
         if !ray_is_finite(ray) {
             return None;
@@ -137,8 +149,9 @@ impl Accel {
         bvh_hit(bvh, self.closest(bvh, ray, tmax)).or(best)
     }
 
-    /// True when anything blocks the ray in (0, ray.tmax).
-    pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
+    /// True when anything blocks the ray in (0, ray.tmax), inlined into the caller (`Scene::ray_test`).
+    #[inline(always)]
+    pub fn occluded_inline(&self, shapes: &[Shape], ray: &Ray) -> bool {
         // A NaN or infinite ray carries no light: report it blocked.
         if !ray_is_finite(ray) {
             return true;
