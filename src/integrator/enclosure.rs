@@ -1,4 +1,6 @@
-//! Media whose emitter sampling can never contribute, decided once at scene load from the geometry.
+//! Media whose emitter sampling can never contribute, decided once at scene load from the geometry
+//! (and, [`surfaces_block_shadow_rays`], scenes where every surface ends a shadow ray, so its
+//! transmittance needs one any-hit query).
 //!
 //! A shadow ray from a medium vertex walks through the medium to the emitter and stops at the first
 //! surface that is not null-transmissive (`walk.rs`, `volpath::shadow_transmittance`). When the
