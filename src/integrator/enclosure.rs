@@ -1,4 +1,6 @@
-//! Media whose emitter sampling can never contribute, decided once at scene load from the geometry.
+//! Media whose emitter sampling can never contribute, decided once at scene load from the geometry
+//! (and, [`surfaces_block_shadow_rays`], scenes where every surface ends a shadow ray, so its
+//! transmittance needs one any-hit query).
 //!
 //! A shadow ray from a medium vertex walks through the medium to the emitter and stops at the first
 //! surface that is not null-transmissive (`walk.rs`, `volpath::shadow_transmittance`). When the
@@ -63,6 +65,17 @@ fn unreachable(scene: &Scene, medium: u32) -> bool {
         SceneEmitter::Other(_) => true,
     });
     others_ok && emitters_ok
+}
+
+/// True when no shape's BSDF lets a shadow ray through: none is `null`, `thindielectric` or `mask`
+/// (the BSDFs whose `eval_null_transmission` can be non-zero) and none has a null lobe. Then a
+/// shadow ray ends at the first surface it meets, so its transmittance needs only an any-hit query
+/// (`volpath::shadow_transmittance`).
+pub fn surfaces_block_shadow_rays(scene: &Scene) -> bool {
+    scene.shapes.iter().all(|s| {
+        let b = &scene.bsdfs[s.bsdf as usize];
+        !matches!(b, Bsdf::Null | Bsdf::ThinDielectric(_) | Bsdf::Mask(_)) && b.flags() & flags::NULL == 0
+    })
 }
 
 /// Do the boxes share a point?

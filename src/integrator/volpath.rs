@@ -85,6 +85,9 @@ pub fn shadow_transmittance(
     sampler: &mut Sampler,
     stats: &mut LocalStats,
 ) -> Spectrum {
+    if scene.surfaces_block_shadow_rays {
+        return shadow_transmittance_opaque(scene, ray, medium, channel, sampler, stats);
+    }
     let mut tr = Spectrum::ONE;
     let mut remaining = ray.tmax;
     for _ in 0..MAX_SEGMENTS {
@@ -124,6 +127,47 @@ pub fn shadow_transmittance(
         ray.o = offset_origin(si.p, si.n, ray.d);
     }
     tr
+}
+
+/// [`shadow_transmittance`] in a scene where every surface blocks shadow rays
+/// (`Scene::surfaces_block_shadow_rays`): the walk has one segment, which a surface ends with 0, so
+/// an any-hit query up to the sampled distance decides it. The same samples, the same value (the
+/// full walk multiplies by a zero null transmission at the first surface), one ray counted.
+#[inline]
+fn shadow_transmittance_opaque(
+    scene: &Scene,
+    mut ray: Ray,
+    medium: Option<u32>,
+    channel: usize,
+    sampler: &mut Sampler,
+    stats: &mut LocalStats,
+) -> Spectrum {
+    let remaining = ray.tmax;
+    if !(remaining > 0.0) {
+        return Spectrum::ONE;
+    }
+    let m = medium.map(|m| &scene.media[m as usize]);
+    let t = m.map_or(f32::INFINITY, |m| m.sample_distance(sampler.next_1d(), channel));
+    ray.tmax = if t < remaining { t.next_up() } else { remaining };
+    stats.rays += 1;
+    // A non-finite ray has no hit in `ray_intersect` (the full walk's query); `ray_test` reports it blocked.
+    if (ray.o + ray.d).is_finite() && scene.ray_test(&ray) {
+        return Spectrum::ZERO;
+    }
+    let Some(m) = m else { return Spectrum::ONE };
+    if t < remaining {
+        // A real collision before the end of the ray.
+        return Spectrum::ZERO;
+    }
+    if !remaining.is_finite() {
+        return Spectrum::ONE;
+    }
+    let t_seg = m.transmittance(remaining);
+    let p = t_seg[channel];
+    if !(p > 0.0) {
+        return Spectrum::ZERO;
+    }
+    t_seg / p
 }
 
 /// Radiance along a camera ray starting in `medium`; also whether the ray is "valid" (alpha).

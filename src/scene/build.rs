@@ -167,8 +167,10 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         integrator: Integrator::Path(IntegratorDesc::default()),
         bounds,
         emitters_unreachable: Vec::new(),
+        surfaces_block_shadow_rays: false,
     };
     scene.emitters_unreachable = integrator::enclosure::emitters_unreachable(&scene);
+    scene.surfaces_block_shadow_rays = integrator::enclosure::surfaces_block_shadow_rays(&scene);
     scene.integrator = integrator::build(integrator, &scene);
     Ok(scene)
 }

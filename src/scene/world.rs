@@ -45,13 +45,16 @@ pub struct Scene {
     pub bounds: Aabb,
     /// Per medium: emitter sampling from inside it always returns 0 (`integrator/enclosure.rs`).
     pub emitters_unreachable: Vec<bool>,
+    /// No surface lets a shadow ray through (no null, thindielectric or mask BSDF): shadow-ray
+    /// transmittance needs one any-hit query (`integrator/enclosure.rs`).
+    pub surfaces_block_shadow_rays: bool,
 }
 
 impl Scene {
     /// Closest surface hit.
     #[inline]
     pub fn ray_intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let hit = self.accel.intersect(&self.shapes, ray)?;
+        let hit = self.accel.intersect_inline(&self.shapes, ray)?;
         let mut si = self.shapes[hit.shape as usize].interaction(hit.prim, hit.b1, hit.b2, hit.t, ray);
         si.shape = hit.shape;
         Some(si)
@@ -60,7 +63,7 @@ impl Scene {
     /// True when the segment is blocked.
     #[inline]
     pub fn ray_test(&self, ray: &Ray) -> bool {
-        self.accel.occluded(&self.shapes, ray)
+        self.accel.occluded_inline(&self.shapes, ray)
     }
 
     /// The BSDF of the shape that was hit.

@@ -53,35 +53,10 @@ impl Sphere {
         4.0 * PI * self.radius * self.radius
     }
 
-    /// Nearest intersection distance in (0, tmax), in `f32` with the robust discriminant of
-    /// Haines et al. 2019 (Ray Tracing Gems, ch. 7, Eq. 10: b² − ac = a (r² − |f − (f·d/a) d|²),
-    /// free of the cancellation of b² − ac) and the stable root pair (Eqs. 13–14).
+    /// Nearest intersection distance in (0, tmax) ([`intersect_sphere`]).
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
-        let f = ray.o - self.center;
-        let d = ray.d;
-        let r2 = self.radius * self.radius;
-        let a = d.length_squared();
-        // The quadratic a t² − 2 b t + c = 0 with b = −f·d, c = |f|² − r².
-        let b = -f.dot(d);
-        let c = f.length_squared() - r2;
-        let l = f + d * (b / a);
-        let disc = a * (r2 - l.length_squared());
-        if !(disc >= 0.0) {
-            return None;
-        }
-        let q = b + disc.sqrt().copysign(b);
-        let (mut t0, mut t1) = (c / q, q / a);
-        if t0 > t1 {
-            std::mem::swap(&mut t0, &mut t1);
-        }
-        if t0 > 0.0 && t0 < ray.tmax {
-            Some(t0)
-        } else if t1 > 0.0 && t1 < ray.tmax {
-            Some(t1)
-        } else {
-            None
-        }
+        intersect_sphere(self.center, self.radius * self.radius, ray.o, ray.d, ray.tmax)
     }
 
     /// uv = (φ / 2π, θ / π) of a point on the unit sphere in object space.
@@ -174,6 +149,44 @@ impl Sphere {
         } else {
             area_pdf_to_solid_angle(1.0 / self.surface_area(), ds.dist, ds.d, ds.n)
         }
+    }
+}
+
+/// Nearest intersection distance in (0, tmax) of the ray `o + t d` with the sphere of centre
+/// `center` and squared radius `r2`, in `f32` with the robust discriminant of Haines et al. 2019
+/// (Ray Tracing Gems, ch. 7, Eq. 10: b² − ac = a (r² − |f − (f·d/a) d|²), free of the
+/// cancellation of b² − ac) and the stable root pair (Eqs. 13–14).
+///
+/// A ray starting outside (c > 0) and pointing away from the centre (b < 0) is rejected before
+/// the division and the square root: both roots are then negative (their product c / a is
+/// positive, their sum 2b / a negative), and the full computation returns `None` for it too
+/// (q = b − √disc < 0, so t1 = q / a < 0 and t0 = c / q < 0), so the result is the same bit for bit.
+#[inline(always)]
+pub fn intersect_sphere(center: Vec3, r2: f32, o: Vec3, d: Vec3, tmax: f32) -> Option<f32> {
+    let f = o - center;
+    // The quadratic a t² − 2 b t + c = 0 with b = −f·d, c = |f|² − r².
+    let b = -f.dot(d);
+    let c = f.length_squared() - r2;
+    if c > 0.0 && b < 0.0 {
+        return None;
+    }
+    let a = d.length_squared();
+    let l = f + d * (b / a);
+    let disc = a * (r2 - l.length_squared());
+    if !(disc >= 0.0) {
+        return None;
+    }
+    let q = b + disc.sqrt().copysign(b);
+    let (mut t0, mut t1) = (c / q, q / a);
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    if t0 > 0.0 && t0 < tmax {
+        Some(t0)
+    } else if t1 > 0.0 && t1 < tmax {
+        Some(t1)
+    } else {
+        None
     }
 }
 
@@ -273,5 +286,43 @@ mod tests {
             }
         }
         assert!(checked > 50_000, "only {checked} rays compared");
+    }
+
+    /// The early reject (outside and pointing away) changes no result: the test equals the full
+    /// computation without it, bit for bit, on rays from inside, outside, towards and away.
+    #[test]
+    fn early_reject_is_exact() {
+        let full = |center: Vec3, r2: f32, o: Vec3, d: Vec3, tmax: f32| {
+            let f = o - center;
+            let (a, b, c) = (d.length_squared(), -f.dot(d), f.length_squared() - r2);
+            let l = f + d * (b / a);
+            let disc = a * (r2 - l.length_squared());
+            if !(disc >= 0.0) {
+                return None;
+            }
+            let q = b + disc.sqrt().copysign(b);
+            let (mut t0, mut t1) = (c / q, q / a);
+            if t0 > t1 {
+                std::mem::swap(&mut t0, &mut t1);
+            }
+            [t0, t1].into_iter().find(|&t| t > 0.0 && t < tmax)
+        };
+        let mut s = Sampler::new(9, 0);
+        let mut rejected = 0;
+        for i in 0..200_000 {
+            let center = (Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) - 0.5) * 20.0;
+            let r = 0.01 + 3.0 * s.next_1d();
+            let o = center + warp::square_to_uniform_sphere(s.next_2d()) * r * (0.5 + 2.0 * s.next_1d());
+            let mut d = warp::square_to_uniform_sphere(s.next_2d()) * (0.5 + s.next_1d());
+            if i % 5 == 0 {
+                d = Vec3::new(d.x, 0.0, -0.0);
+            }
+            let tmax = if i % 2 == 0 { f32::INFINITY } else { 10.0 * s.next_1d() };
+            let got = intersect_sphere(center, r * r, o, d, tmax);
+            assert_eq!(got.map(f32::to_bits), full(center, r * r, o, d, tmax).map(f32::to_bits), "{o:?} {d:?}");
+            let f = o - center;
+            rejected += (f.length_squared() > r * r && f.dot(d) > 0.0) as u32;
+        }
+        assert!(rejected > 50_000, "only {rejected} rays took the early reject");
     }
 }

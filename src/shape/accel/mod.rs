@@ -17,10 +17,10 @@ use super::{Geometry, Shape};
 use crate::math::Ray;
 use build::Bounds;
 use bvh8::Bvh8;
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
-use traverse::{Stack, STACK};
+use traverse::STACK;
 
 /// Closest hit: shape, primitive, barycentrics of vertices 1 and 2, distance.
 #[derive(Clone, Copy, Debug)]
@@ -59,8 +59,15 @@ impl Isa {
 pub struct Accel {
     bvh: Option<Bvh8>,
     /// Shapes tested outside the BVH (spheres, disks).
-    analytic: Vec<u32>,
+    analytic: Vec<Analytic>,
     isa: Isa,
+}
+
+/// A shape tested outside the BVH, with what its test needs copied out of the shape.
+#[derive(Clone, Copy, Debug)]
+enum Analytic {
+    Sphere { shape: u32, center: Vec3, r2: f32 },
+    Disk { shape: u32 },
 }
 
 impl Accel {
@@ -93,7 +100,10 @@ impl Accel {
                         b
                     }));
                 }
-                _ => analytic.push(si as u32),
+                Geometry::Sphere(sp) => {
+                    analytic.push(Analytic::Sphere { shape: si as u32, center: sp.center, r2: sp.radius * sp.radius })
+                }
+                Geometry::Disk(_) => analytic.push(Analytic::Disk { shape: si as u32 }),
             }
         }
         let bvh = build::build(bounds, |id| {
@@ -116,76 +126,127 @@ impl Accel {
         self.bvh.as_ref().map_or((0, 0, 0), |b| (b.nodes.len(), b.packets.len(), b.depth))
     }
 
-    /// Closest hit along the ray in (0, ray.tmax).
+    /// Closest hit along the ray in (0, ray.tmax): [`Accel::intersect_inline`] as a call of its own
+    /// (benchmarks and tests count its instructions; the renderer inlines the query).
     pub fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
+        self.intersect_inline(shapes, ray)
+    }
+
+    /// True when anything blocks the ray in (0, ray.tmax): [`Accel::occluded_inline`] as a call.
+    pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
+        self.occluded_inline(shapes, ray)
+    }
+
+    /// Closest hit along the ray in (0, ray.tmax), inlined into the caller (`Scene::ray_intersect`).
+    #[inline(always)]
+    pub fn intersect_inline(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
         // A NaN or infinite ray has no hit; the traversal's nearest-first order needs finite distances.
         if !ray_is_finite(ray) {
             return None;
         }
-        let mut best = None;
-        let mut tmax = ray.tmax;
-        for &si in &self.analytic {
-            let t = intersect_analytic(&shapes[si as usize], ray, tmax);
-            if t < tmax {
-                tmax = t;
-                best = Some(Hit { shape: si, prim: 0, b1: 0.0, b2: 0.0, t });
-            }
-        }
-        if let Some(bvh) = &self.bvh {
-            if let Some((lane, t, b1, b2)) = self.closest(bvh, ray, tmax) {
-                let (shape, prim) = bvh.lane_prims[lane as usize / 4][lane as usize % 4];
-                best = Some(Hit { shape, prim, b1, b2, t });
-            }
-        }
-        best
+        let (best, tmax) = self.analytic_closest(shapes, ray);
+        let Some(bvh) = &self.bvh else { return best };
+        bvh_hit(bvh, self.closest(bvh, ray, tmax)).or(best)
     }
 
-    /// True when anything blocks the ray in (0, ray.tmax).
-    pub fn occluded(&self, shapes: &[Shape], ray: &Ray) -> bool {
+    /// True when anything blocks the ray in (0, ray.tmax), inlined into the caller (`Scene::ray_test`).
+    #[inline(always)]
+    pub fn occluded_inline(&self, shapes: &[Shape], ray: &Ray) -> bool {
         // A NaN or infinite ray carries no light: report it blocked.
         if !ray_is_finite(ray) {
             return true;
         }
-        for &si in &self.analytic {
-            if intersect_analytic(&shapes[si as usize], ray, ray.tmax) < ray.tmax {
-                return true;
-            }
+        if self.analytic_any(shapes, ray) {
+            return true;
         }
-        let Some(bvh) = &self.bvh else { return false };
-        if traverse::stack_size(bvh.depth) <= STACK {
-            self.any_with(bvh, ray, &mut [const { MaybeUninit::uninit() }; STACK])
-        } else {
-            self.any_with(bvh, ray, &mut heap_stack(bvh.depth))
-        }
+        self.bvh.as_ref().is_some_and(|bvh| self.any(bvh, ray))
     }
 
-    fn closest(&self, bvh: &Bvh8, ray: &Ray, tmax: f32) -> Option<(u32, f32, f32, f32)> {
-        if traverse::stack_size(bvh.depth) <= STACK {
-            self.closest_with(bvh, ray, tmax, &mut [const { MaybeUninit::uninit() }; STACK])
-        } else {
-            self.closest_with(bvh, ray, tmax, &mut heap_stack(bvh.depth))
+    /// The analytic shapes' closest hit in (0, ray.tmax), and the distance the BVH must beat.
+    #[inline(always)]
+    fn analytic_closest(&self, shapes: &[Shape], ray: &Ray) -> (Option<Hit>, f32) {
+        let mut best = None;
+        let mut tmax = ray.tmax;
+        for a in &self.analytic {
+            let (shape, t) = analytic_hit(a, shapes, ray, tmax);
+            if t < tmax {
+                tmax = t;
+                best = Some(Hit { shape, prim: 0, b1: 0.0, b2: 0.0, t });
+            }
         }
+        (best, tmax)
     }
 
     #[inline(always)]
-    fn closest_with(&self, bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
+    fn analytic_any(&self, shapes: &[Shape], ray: &Ray) -> bool {
+        self.analytic.iter().any(|a| analytic_hit(a, shapes, ray, ray.tmax).1 < ray.tmax)
+    }
+
+    /// The BVH's closest hit in (0, tmax): one call into the traversal compiled for the CPU (the
+    /// ray's precomputation happens inside it).
+    #[inline(always)]
+    fn closest(&self, bvh: &Bvh8, ray: &Ray, tmax: f32) -> Option<(u32, f32, f32, f32)> {
+        if traverse::stack_size(bvh.depth) > STACK {
+            return closest_deep(bvh, ray, tmax, self.isa);
+        }
+        let stack = &mut [const { MaybeUninit::uninit() }; STACK];
         #[cfg(target_arch = "x86_64")]
         if self.isa == Isa::Avx2 {
             // SAFETY: `Isa::Avx2` is only set when the CPU supports it (checked in `build_with`).
-            return unsafe { traverse::closest_avx2(bvh, ray, tmax, stack) };
+            return unsafe { traverse::closest_avx2(bvh, ray.o, ray.d, tmax, stack) };
         }
-        traverse::closest_portable(bvh, ray, tmax, stack)
+        traverse::closest_portable(bvh, ray.o, ray.d, tmax, stack)
     }
 
     #[inline(always)]
-    fn any_with(&self, bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+    fn any(&self, bvh: &Bvh8, ray: &Ray) -> bool {
+        if traverse::stack_size(bvh.depth) > STACK {
+            return any_deep(bvh, ray, self.isa);
+        }
+        let stack = &mut [const { MaybeUninit::uninit() }; STACK];
         #[cfg(target_arch = "x86_64")]
         if self.isa == Isa::Avx2 {
-            // SAFETY: as in `closest_with`.
-            return unsafe { traverse::any_avx2(bvh, ray, ray.tmax, stack) };
+            // SAFETY: as in `closest`.
+            return unsafe { traverse::any_avx2(bvh, ray.o, ray.d, ray.tmax, stack) };
         }
-        traverse::any_portable(bvh, ray, ray.tmax, stack)
+        traverse::any_portable(bvh, ray.o, ray.d, ray.tmax, stack)
     }
+}
+
+/// The BVH's hit as a `Hit` (shape and triangle of the lane).
+#[inline(always)]
+fn bvh_hit(bvh: &Bvh8, found: Option<(u32, f32, f32, f32)>) -> Option<Hit> {
+    let (lane, t, b1, b2) = found?;
+    let (shape, prim) = bvh.lane_prims[lane as usize / 4][lane as usize % 4];
+    Some(Hit { shape, prim, b1, b2, t })
+}
+
+/// Closest hit in a tree too deep for the fixed stack (a heap stack).
+#[cold]
+#[inline(never)]
+fn closest_deep(bvh: &Bvh8, ray: &Ray, tmax: f32, isa: Isa) -> Option<(u32, f32, f32, f32)> {
+    let stack = &mut heap_stack(bvh.depth);
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx2 {
+        // SAFETY: `Isa::Avx2` is only set when the CPU supports it.
+        return unsafe { traverse::closest_avx2(bvh, ray.o, ray.d, tmax, stack) };
+    }
+    let _ = isa;
+    traverse::closest_portable(bvh, ray.o, ray.d, tmax, stack)
+}
+
+/// Any hit in a tree too deep for the fixed stack.
+#[cold]
+#[inline(never)]
+fn any_deep(bvh: &Bvh8, ray: &Ray, isa: Isa) -> bool {
+    let stack = &mut heap_stack(bvh.depth);
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx2 {
+        // SAFETY: as in `closest_deep`.
+        return unsafe { traverse::any_avx2(bvh, ray.o, ray.d, ray.tmax, stack) };
+    }
+    let _ = isa;
+    traverse::any_portable(bvh, ray.o, ray.d, ray.tmax, stack)
 }
 
 /// Shape and triangle of builder index `id`.
@@ -200,15 +261,21 @@ fn heap_stack(depth: usize) -> Vec<MaybeUninit<traverse::Entry>> {
     vec![MaybeUninit::uninit(); traverse::stack_size(depth)]
 }
 
-#[inline]
-fn intersect_analytic(shape: &Shape, ray: &Ray, tmax: f32) -> f32 {
-    let r = Ray { o: ray.o, d: ray.d, tmax };
-    let t = match &shape.geometry {
-        Geometry::Sphere(s) => s.intersect(&r),
-        Geometry::Disk(d) => d.intersect(&r),
-        Geometry::Mesh(_) => None,
-    };
-    t.unwrap_or(f32::INFINITY)
+/// The shape of `a` and its hit distance in (0, tmax) (`f32::INFINITY` when none).
+#[inline(always)]
+fn analytic_hit(a: &Analytic, shapes: &[Shape], ray: &Ray, tmax: f32) -> (u32, f32) {
+    match *a {
+        Analytic::Sphere { shape, center, r2 } => {
+            (shape, super::sphere::intersect_sphere(center, r2, ray.o, ray.d, tmax).unwrap_or(f32::INFINITY))
+        }
+        Analytic::Disk { shape } => {
+            let t = match &shapes[shape as usize].geometry {
+                Geometry::Disk(d) => d.intersect(&Ray { o: ray.o, d: ray.d, tmax }),
+                _ => None,
+            };
+            (shape, t.unwrap_or(f32::INFINITY))
+        }
+    }
 }
 
 #[cfg(test)]

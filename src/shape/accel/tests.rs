@@ -137,3 +137,37 @@ fn non_finite_rays_do_not_panic() {
         }
     }
 }
+
+/// The branch-free per-ray setup (one division for both tests) gives the scalar setup's values bit
+/// for bit: `shear_axes`'s axes and shear, and the node test's clamped inverse and octant rows, on
+/// random, axis-aligned, signed-zero and tied directions.
+#[test]
+fn trace_ray_setup_equals_scalar() {
+    let mut s = Sampler::new(21, 0);
+    let mut dirs = vec![Vec3::X, -Vec3::Y, Vec3::Z, Vec3::new(-0.0, 0.0, -1.0), Vec3::new(1.0, 1.0, 1.0)];
+    dirs.extend([Vec3::new(-1.0, 1.0, 0.5), Vec3::new(0.5, -1.0, -1.0), Vec3::new(-0.0, -0.0, 2.0)]);
+    for i in 0..20_000 {
+        let d = warp::square_to_uniform_sphere(s.next_2d());
+        dirs.push(match i % 4 {
+            0 => Vec3::new(d.x, -0.0, d.z),
+            1 => Vec3::new(d.x, d.x, d.z),
+            _ => d,
+        });
+    }
+    for d in dirs {
+        let o = Vec3::new(s.next_1d(), s.next_1d(), s.next_1d());
+        let tr = traverse::TraceRay::new(o, d);
+        // The scalar setup.
+        let d0 = d + Vec3::ZERO;
+        let inv = |x: f32| if (1.0 / x).is_finite() { 1.0 / x } else { f32::MAX.copysign(x) };
+        let want_inv = [inv(d0.x), inv(d0.y), inv(d0.z)].map(f32::to_bits);
+        assert_eq!(tr.node.inv_d.map(f32::to_bits), want_inv, "{d:?}");
+        for a in 0..3 {
+            let neg = (d0[a] < 0.0) as usize;
+            assert_eq!((tr.node.near[a], tr.node.far[a]), (2 * a + neg, 2 * a + 1 - neg), "{d:?}");
+        }
+        let (k, sh) = triangle::shear_axes(d);
+        let want = WatertightRay::from_parts(k, sh, o);
+        assert_eq!(format!("{:?}", tr.wt), format!("{want:?}"), "{d:?}");
+    }
+}

@@ -10,7 +10,7 @@
 
 use super::bvh8::{Bvh8, Node8, EMPTY, LEAF};
 use super::triangle::WatertightRay;
-use crate::math::{Ray, Vec3};
+use crate::math::Vec3;
 use glam::Vec4;
 use std::mem::MaybeUninit;
 
@@ -31,23 +31,42 @@ impl NodeRay {
     #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> NodeRay {
         // −0.0 → +0.0, so that the sign test and the inverse agree.
-        let d = d + Vec3::ZERO;
-        let inv = |x: f32| {
-            let i = 1.0 / x;
-            if i.is_finite() {
-                i
-            } else {
-                f32::MAX.copysign(x)
-            }
-        };
-        let row = |axis: usize, neg: bool| 2 * axis + neg as usize;
-        let neg = [d.x < 0.0, d.y < 0.0, d.z < 0.0];
+        let d0 = Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO;
+        Self::with_inverse(o, d0, Vec4::ONE / d0)
+    }
+
+    /// From `d0` = d + 0 (w lane 1) and its inverse `inv` = 1 / d0: a non-finite inverse (zero
+    /// component) becomes ±`f32::MAX` with the sign of the component, so no 0 · ∞ makes a NaN.
+    /// Branch-free; the same values as the scalar `1 / x, else MAX.copysign(x)`.
+    #[inline(always)]
+    pub fn with_inverse(o: Vec3, d0: Vec4, inv: Vec4) -> NodeRay {
+        let finite = inv.abs().cmplt(Vec4::splat(f32::INFINITY));
+        let inv_d = Vec4::select(finite, inv, Vec4::splat(f32::MAX).copysign(d0));
+        let neg = d0.cmplt(Vec4::ZERO).bitmask() as usize;
+        let (nx, ny, nz) = (neg & 1, (neg >> 1) & 1, (neg >> 2) & 1);
         NodeRay {
             o: o.to_array(),
-            inv_d: [inv(d.x), inv(d.y), inv(d.z)],
-            near: [row(0, neg[0]), row(1, neg[1]), row(2, neg[2])],
-            far: [row(0, !neg[0]), row(1, !neg[1]), row(2, !neg[2])],
+            inv_d: inv_d.truncate().to_array(),
+            near: [nx, 2 + ny, 4 + nz],
+            far: [1 - nx, 3 - ny, 5 - nz],
         }
+    }
+}
+
+/// Everything the traversal needs of one ray, computed once per ray with one division: the node
+/// test's inverse direction and octant, and the triangle test's axes and shear.
+#[derive(Clone, Copy, Debug)]
+pub struct TraceRay {
+    pub node: NodeRay,
+    pub wt: WatertightRay,
+}
+
+impl TraceRay {
+    #[inline(always)]
+    pub fn new(o: Vec3, d: Vec3) -> TraceRay {
+        let d0 = Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO;
+        let inv = Vec4::ONE / d0;
+        TraceRay { node: NodeRay::with_inverse(o, d0, inv), wt: WatertightRay::with_inverse(o, d, inv) }
     }
 }
 
@@ -139,10 +158,10 @@ pub type Stack = [MaybeUninit<Entry>];
 /// of the nearest triangle in (0, tmax). A macro, so that each instance is compiled with the
 /// target features of the function it expands in and the node test inlines.
 macro_rules! closest_body {
-    ($bvh:expr, $ray:expr, $tmax:expr, $stack:expr, $node_test:ident) => {{
-        let (bvh, ray, mut tmax, stack): (&Bvh8, &Ray, f32, &mut Stack) = ($bvh, $ray, $tmax, $stack);
-        let nr = NodeRay::new(ray.o, ray.d);
-        let wt = WatertightRay::new(ray.o, ray.d);
+    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident) => {{
+        let (bvh, mut tmax, stack): (&Bvh8, f32, &mut Stack) = ($bvh, $tmax, $stack);
+        let tr = TraceRay::new($o, $d);
+        let (nr, wt) = (&tr.node, &tr.wt);
         let mut found = None;
         let mut sp = 0usize;
         let mut cur = bvh.root;
@@ -151,7 +170,7 @@ macro_rules! closest_body {
             // Descend through inner nodes to the nearest hit child until a leaf (or nothing) is next.
             while cur & LEAF == 0 {
                 let node = &bvh.nodes[cur as usize];
-                let mut mask = $node_test!(node, &nr, tmax, &mut t_near);
+                let mut mask = $node_test!(node, nr, tmax, &mut t_near);
                 if mask == 0 {
                     cur = EMPTY;
                     break;
@@ -222,17 +241,17 @@ macro_rules! closest_body {
 
 /// Any-hit traversal with node test `$node_test`: true when a triangle is hit in (0, tmax).
 macro_rules! any_body {
-    ($bvh:expr, $ray:expr, $tmax:expr, $stack:expr, $node_test:ident) => {{
-        let (bvh, ray, tmax, stack): (&Bvh8, &Ray, f32, &mut Stack) = ($bvh, $ray, $tmax, $stack);
-        let nr = NodeRay::new(ray.o, ray.d);
-        let wt = WatertightRay::new(ray.o, ray.d);
+    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident) => {{
+        let (bvh, tmax, stack): (&Bvh8, f32, &mut Stack) = ($bvh, $tmax, $stack);
+        let tr = TraceRay::new($o, $d);
+        let (nr, wt) = (&tr.node, &tr.wt);
         let mut sp = 0usize;
         let mut cur = bvh.root;
         let mut t_near = [0.0f32; 8];
         loop {
             if cur & LEAF == 0 {
                 let node = &bvh.nodes[cur as usize];
-                let mut mask = $node_test!(node, &nr, tmax, &mut t_near);
+                let mut mask = $node_test!(node, nr, tmax, &mut t_near);
                 if mask != 0 {
                     // Descend into the hit child of the highest slot; push the others (lowest
                     // first, so they are visited from the highest down).
@@ -261,13 +280,13 @@ macro_rules! any_body {
 }
 
 /// Closest hit, portable node test.
-pub fn closest_portable(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
-    closest_body!(bvh, ray, tmax, stack, node_test_portable_body)
+pub fn closest_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
+    closest_body!(bvh, o, d, tmax, stack, node_test_portable_body)
 }
 
 /// Any hit, portable node test.
-pub fn any_portable(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> bool {
-    any_body!(bvh, ray, tmax, stack, node_test_portable_body)
+pub fn any_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> bool {
+    any_body!(bvh, o, d, tmax, stack, node_test_portable_body)
 }
 
 /// Closest hit, AVX node test.
@@ -276,8 +295,8 @@ pub fn any_portable(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> bool
 /// The CPU must support AVX2, BMI1, LZCNT and POPCNT (`Isa::detect`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
-pub unsafe fn closest_avx2(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
-    closest_body!(bvh, ray, tmax, stack, node_test_avx_body)
+pub unsafe fn closest_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
+    closest_body!(bvh, o, d, tmax, stack, node_test_avx_body)
 }
 
 /// Any hit, AVX node test.
@@ -286,6 +305,6 @@ pub unsafe fn closest_avx2(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) 
 /// As for `closest_avx2`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
-pub unsafe fn any_avx2(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> bool {
-    any_body!(bvh, ray, tmax, stack, node_test_avx_body)
+pub unsafe fn any_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> bool {
+    any_body!(bvh, o, d, tmax, stack, node_test_avx_body)
 }

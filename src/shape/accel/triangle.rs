@@ -79,8 +79,37 @@ fn sheared(w: &WatertightRay, p: &TriPacket4, j: usize) -> (Vec4, Vec4, Vec4) {
 impl WatertightRay {
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        let (k, s) = shear_axes(d);
+        let d0 = Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO;
+        Self::with_inverse(o, d, Vec4::ONE / d0)
+    }
+
+    /// The test's state from axes `k` and shear `s` as [`shear_axes`] gives them.
+    pub fn from_parts(k: [usize; 3], s: [f32; 3], o: Vec3) -> Self {
         WatertightRay { k, s: s.map(Vec4::splat), o: k.map(|a| Vec4::splat(o[a])) }
+    }
+
+    /// [`WatertightRay::new`] given `inv` = 1 / (d + 0) per axis (the node test's unclamped inverse,
+    /// so that one division serves both): the axes of [`shear_axes`] chosen without branches, and
+    /// `sz` read from `inv` (the same division; it differs from `1 / d[kz]` only in the sign of an
+    /// infinity when `d` is zero, where every lane is NaN and misses either way).
+    #[inline(always)]
+    pub fn with_inverse(o: Vec3, d: Vec3, inv: Vec4) -> Self {
+        let a = d.abs();
+        let (xy, xz, yz) = ((a.x > a.y) as usize, (a.x > a.z) as usize, (a.y > a.z) as usize);
+        // shear_axes: a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2).
+        let kz = if xy != 0 { 2 - 2 * xz } else { 2 - yz };
+        let (d, o, inv) = (d.to_array(), o.to_array(), inv.to_array());
+        let next = |k: usize| if k == 2 { 0 } else { k + 1 };
+        let (mut kx, mut ky) = (next(kz), next(next(kz)));
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let sz = inv[kz];
+        WatertightRay {
+            k: [kx, ky, kz],
+            s: [Vec4::splat(d[kx] * sz), Vec4::splat(d[ky] * sz), Vec4::splat(sz)],
+            o: [Vec4::splat(o[kx]), Vec4::splat(o[ky]), Vec4::splat(o[kz])],
+        }
     }
 
     /// Lane mask of the hits in (0, tmax) and their (t, b1, b2) (b1, b2: barycentrics of vertices 1, 2).
