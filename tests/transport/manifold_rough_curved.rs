@@ -8,8 +8,8 @@
 //! `volpath` (Welch on the image and 8×8 blocks of independent batches, Šidák at family-wise 1 %):
 //! - under an oblique directional light, α = 0.2 and α = 0.04;
 //! - under an environment map (hidden), α = 0.2 (forward BSDF sampling out of `x_k` is a technique);
-//! - under a sphere light, α = 0.2 (the connection does not handle finite lights: its density is 0
-//!   there and the other techniques keep their weights; the render must stay unbiased).
+//! - under a sphere light, α = 0.2 (the finite-light connection of docs/manifold.md §7.2 shares the
+//!   suffix with the other techniques; the render must stay unbiased).
 //!
 //! Sample counts chosen before the first run (as `manifold_rough.rs`): `volpath` 12 × 512 spp,
 //! `complete` 12 × 128 spp (envmap: 12 × 128 each).
