@@ -45,6 +45,7 @@ pub mod pdf;
 pub mod planes;
 pub mod rough;
 pub mod rough_finite;
+pub mod rough_lobe;
 pub mod stage;
 pub mod track;
 

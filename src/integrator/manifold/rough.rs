@@ -40,19 +40,23 @@
 
 use super::planes::{MAX_PLANES, SAME_NORMAL};
 use super::{light_segment, MediumVertex};
-use crate::bsdf::fresnel::{fresnel, refract};
-use crate::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
+use crate::bsdf::{Bsdf, BsdfContext};
 use crate::color::Spectrum;
 use crate::integrator::cx::{Cx, Scatter};
 use crate::integrator::snee::SneeVertex;
 use crate::integrator::snee::{with_wi, LightSample, SneeOptions, SneeSuffix, SneeTechnique};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
-use crate::math::{Frame, Ray, Vec2, Vec3};
+use crate::math::{Ray, Vec2, Vec3};
 use crate::scene::world::Scene;
 use crate::shape::Geometry;
 
 pub use super::planes::{RoughBoundary, RoughPlane};
+pub use super::rough_lobe::{
+    curved_reference, pdf_inner, pdf_inner_in, rough_pdfs, rough_weight, sample_inner, sample_inner_in, Reference,
+    RoughPdfs, RoughPending, RoughTechnique,
+};
+use super::rough_lobe::{on_boundary, on_plane};
 
 /// Per medium of `scene`: its rough boundary, or `None` (no emitter, the medium does not sample
 /// emitters, or some enclosing shape is not a mesh or sphere with an isotropic `roughdielectric`).
@@ -115,67 +119,6 @@ pub fn boundary_of(scene: &Scene, medium: u32) -> Option<&RoughBoundary> {
     super::tables(scene)?.rough.get(medium as usize)?.as_ref()
 }
 
-/// Where the connection samples the inner direction: a shading frame and a `roughdielectric`
-/// (index into `Scene::bsdfs`). Flat: the plane's ([`Reference::of_plane`]); curved: the shading
-/// frame where the straight line from `x_j` towards the light meets the boundary
-/// ([`curved_reference`]).
-#[derive(Clone, Copy, Debug)]
-pub struct Reference {
-    pub frame: Frame,
-    pub bsdf: u32,
-}
-
-impl Reference {
-    /// The frame of a flat orientation (any tangent: the roughness is isotropic).
-    #[inline]
-    pub fn of_plane(plane: &RoughPlane) -> Self {
-        Reference { frame: Frame::from_normal(plane.n), bsdf: plane.bsdf }
-    }
-}
-
-/// The reference of the connection from `p_j` (inside `medium`) towards a light in the direction
-/// `omega_l` through a CURVED rough boundary (docs/manifold.md §7.1): `x_0`, the first hit of the
-/// ray `(p_j, omega_l)`, must be `medium`'s enclosing rough boundary met from inside (else `None`:
-/// the connection's density is 0 for every suffix from `p_j` towards `omega_l`); then `x_1`, the
-/// first hit along the reverse of `omega_l` refracted smoothly about `x_0`'s shading normal (where
-/// the α → 0 solution about lands); the reference is `x_1`'s shading frame and BSDF, or `x_0`'s
-/// when that refraction is total or `x_1` is not on the boundary. A deterministic function of
-/// `(p_j, omega_l)`: every technique that evaluates the connection's density recomputes it from
-/// the path's own `x_j` (two rays).
-pub fn curved_reference(
-    scene: &Scene,
-    medium: u32,
-    p_j: Vec3,
-    omega_l: Vec3,
-    stats: &mut LocalStats,
-) -> Option<Reference> {
-    stats.rays += 1;
-    let si0 = scene.ray_intersect(&Ray::new(p_j, omega_l))?;
-    if !on_boundary(scene, &si0, medium, omega_l) {
-        return None;
-    }
-    let of = |si: &SurfaceInteraction| Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf };
-    let mut si = si0;
-    for _ in 0..REFINE_STEPS {
-        let Bsdf::RoughDielectric(b) = scene.bsdf(&si) else { break };
-        let wl = si.to_local(omega_l);
-        let (f, cos_t, _, eta_ti) = fresnel(wl.z, b.eta);
-        if !(wl.z > 0.0) || f >= 1.0 {
-            break;
-        }
-        let d = -si.to_world(refract(wl, cos_t, eta_ti)).normalize();
-        stats.rays += 1;
-        match scene.ray_intersect(&Ray::new(p_j, d)) {
-            Some(next) if on_boundary(scene, &next, medium, d) => si = next,
-            _ => break,
-        }
-    }
-    Some(of(&si))
-}
-
-/// Refinement steps of [`curved_reference`] (each one ray at every evaluation of the density).
-pub(super) const REFINE_STEPS: usize = 2;
-
 /// The reference in which the connection at `x_j` would have sampled a suffix towards `omega_l`
 /// whose boundary point is on `plane` (flat) or anywhere on a curved boundary (`plane = None`).
 fn reference_of(
@@ -189,83 +132,6 @@ fn reference_of(
         Some(p) => Some(Reference::of_plane(p)),
         None => curved_reference(scene, x_j.medium, x_j.p, omega_l, stats),
     }
-}
-
-/// A surface interaction in the shading frame `sh_frame` whose incident direction is `wi`.
-fn frame_si(sh_frame: Frame, wi: Vec3) -> SurfaceInteraction {
-    SurfaceInteraction {
-        t: 0.0,
-        p: Vec3::ZERO,
-        n: sh_frame.n,
-        sh_frame,
-        uv: Vec2::ZERO,
-        wi: sh_frame.to_local(wi),
-        shape: 0,
-        prim: 0,
-    }
-}
-
-/// Sample the direction `omega_jk` (from `x_j` towards the boundary, `= −omega_in`) through a plane
-/// of normal `n` with the rough dielectric `bsdf` lit from `omega_l`: `omega_in ~ bsdf.sample` with
-/// `wi = omega_l` in importance mode; `None` when the light is behind the plane or a reflection
-/// was sampled. Density: [`pdf_inner`].
-pub fn sample_inner(bsdf: &Bsdf, n: Vec3, omega_l: Vec3, u1: f32, u2: Vec2) -> Option<Vec3> {
-    sample_inner_in(bsdf, Frame::from_normal(n), omega_l, u1, u2)
-}
-
-/// [`sample_inner`] in the shading frame `frame` (its normal `frame.n` takes the plane's place).
-pub fn sample_inner_in(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, u1: f32, u2: Vec2) -> Option<Vec3> {
-    let n = frame.n;
-    if !(n.dot(omega_l) > 0.0) {
-        return None;
-    }
-    let si = frame_si(frame, omega_l);
-    let (bs, _) = bsdf.sample(&BsdfContext::new(TransportMode::Importance), &si, u1, u2)?;
-    if bs.sampled_type & flags::TRANSMISSION == 0 || !(bs.pdf > 0.0) {
-        return None;
-    }
-    let omega_in = si.to_world(bs.wo).normalize();
-    (omega_in.dot(n) < 0.0).then_some(-omega_in)
-}
-
-/// Solid-angle density of [`sample_inner`]'s `omega_jk` (the `1 − F` of choosing the
-/// transmission included: the directions integrate to the transmitted fraction).
-pub fn pdf_inner(bsdf: &Bsdf, n: Vec3, omega_l: Vec3, omega_jk: Vec3) -> f64 {
-    pdf_inner_in(bsdf, Frame::from_normal(n), omega_l, omega_jk)
-}
-
-/// [`pdf_inner`] in the shading frame `frame`: the density of [`sample_inner_in`].
-pub fn pdf_inner_in(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, omega_jk: Vec3) -> f64 {
-    let n = frame.n;
-    if !(n.dot(omega_l) > 0.0) || !(omega_jk.dot(n) > 0.0) {
-        return 0.0;
-    }
-    let si = frame_si(frame, omega_l);
-    let p = bsdf.pdf(&BsdfContext::new(TransportMode::Importance), &si, si.to_local(-omega_jk)) as f64;
-    if p.is_finite() && p > 0.0 {
-        p
-    } else {
-        0.0
-    }
-}
-
-/// Is `si` (hit from inside `medium` along `d`) on the orientation `plane` of its rough boundary?
-pub(super) fn on_plane(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3, plane: &RoughPlane) -> bool {
-    let s = &scene.shapes[si.shape as usize];
-    s.interior == Some(medium)
-        && s.exterior.is_none()
-        && d.dot(si.n) > 0.0
-        && s.bsdf == plane.bsdf
-        && si.n.dot(plane.n) > SAME_NORMAL
-}
-
-/// Is `si` (hit along `d`) a point of `medium`'s enclosing rough boundary, met from inside?
-pub(super) fn on_boundary(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3) -> bool {
-    let s = &scene.shapes[si.shape as usize];
-    s.interior == Some(medium)
-        && s.exterior.is_none()
-        && d.dot(si.n) > 0.0
-        && matches!(scene.bsdfs[s.bsdf as usize], Bsdf::RoughDielectric(_))
 }
 
 /// Is `si` (hit along `d`) on the boundary `rb` of `medium`, and on which plane (`Some(None)`: a
@@ -282,96 +148,6 @@ fn locate(
     }
     let plane = rb.plane_at(si.n, scene.shapes[si.shape as usize].bsdf)?;
     on_plane(scene, si, medium, d, plane).then_some(Some(*plane))
-}
-
-/// The four techniques' densities of one suffix `x_j → x_k → light` through a rough plane (solid
-/// angle of `omega_jk` at `x_j`, conditioned on `x_j`; for a non-delta light also per solid angle
-/// of `omega_l`).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RoughPdfs {
-    pub manifold: f64,
-    pub fwd_nee: f64,
-    pub fwd_bsdf: f64,
-    /// 0 outside SNEE's support.
-    pub snee: f64,
-}
-
-/// The densities of the suffix `x_j → x_k → light` (plus `x_i` before, when it is the SNEE vertex
-/// just before `x_j`), with `omega_jk` the direction the path took from `x_j` and `d_jk` its
-/// length. The direction is passed rather than recomputed from the points: at small roughness the
-/// lobe is narrower than the error of `(x_k − x_j)/d` for a vertex `x_j` close to the surface.
-/// `check_support`: test that `x_k` is visible from `x_i` (SNEE's probe); the caller passes
-/// `false` when it knows. `reference`: the frame the connection samples this suffix in (`None`:
-/// the connection cannot make it, its density is 0). The light segment is the caller's business.
-#[allow(clippy::too_many_arguments)]
-pub fn rough_pdfs(
-    scene: &Scene,
-    opts: SneeOptions,
-    x_i: Option<&SneeVertex>,
-    x_j: &MediumVertex,
-    (si_k, omega_jk, d_jk): (&SurfaceInteraction, Vec3, f32),
-    reference: Option<&Reference>,
-    light: &LightSample,
-    channel: usize,
-    check_support: bool,
-    stats: &mut LocalStats,
-) -> RoughPdfs {
-    let m = &scene.media[x_j.medium as usize];
-    let bsdf = scene.bsdf(si_k);
-    let st = m.sigma_t[channel] as f64;
-    // Forward: phase sampling at x_j, a free flight that survives to x_k.
-    let fwd = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp();
-    let fwd_nee = fwd * light.p_light as f64;
-    let fwd_bsdf = if light.delta {
-        0.0
-    } else {
-        let si_kj = with_wi(si_k, -omega_jk);
-        fwd * bsdf.pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l)) as f64
-    };
-    let manifold = match reference {
-        Some(r) if !light.dist.is_finite() => {
-            light.p_light as f64 * pdf_inner_in(&scene.bsdfs[r.bsdf as usize], r.frame, light.omega_l, omega_jk)
-        }
-        _ => 0.0,
-    };
-    let cos_k = omega_jk.dot(si_k.n).abs() as f64;
-    let snee = super::mis::snee_solid_angle_pdf(
-        scene,
-        opts,
-        x_i,
-        x_j,
-        si_k,
-        light,
-        channel,
-        check_support,
-        cos_k,
-        d_jk,
-        stats,
-    );
-    let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
-    RoughPdfs { manifold: finite(manifold), fwd_nee: finite(fwd_nee), fwd_bsdf: finite(fwd_bsdf), snee: finite(snee) }
-}
-
-/// Which technique made a suffix through a rough plane.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RoughTechnique {
-    Manifold,
-    FwdNee,
-    FwdBsdf,
-    Snee,
-}
-
-/// Weight of `technique` for a suffix with densities `p`: the power heuristic over the four
-/// (`snee = mis`); `snee = snee`: SNEE takes what it can make, the others share the rest;
-/// `snee = forward`: SNEE's density is 0. `transport = snee`: suffixes outside SNEE's support get 0.
-pub fn rough_weight(opts: SneeOptions, technique: RoughTechnique, p: RoughPdfs) -> f64 {
-    let own = match technique {
-        RoughTechnique::Manifold => Some(p.manifold),
-        RoughTechnique::FwdNee => Some(p.fwd_nee),
-        RoughTechnique::FwdBsdf => Some(p.fwd_bsdf),
-        RoughTechnique::Snee => None,
-    };
-    super::mis::power_weight(opts, own, &[p.manifold, p.fwd_nee, p.fwd_bsdf], p.snee)
 }
 
 /// One verified connection through a rough plane.
@@ -570,19 +346,6 @@ pub fn snee_weight(
     Some(rough_weight(opts, RoughTechnique::Snee, p))
 }
 
-/// A forward path that refracted out through a rough plane at `x_k` right after the medium vertex
-/// `x_j` (`x_i`: the SNEE vertex before `x_j`, if any), until it escapes to the environment
-/// (carried across passable surfaces only, as the connection's light segment).
-#[derive(Clone, Copy, Debug)]
-pub struct RoughPending {
-    pub x_i: Option<SneeVertex>,
-    pub x_j: MediumVertex,
-    /// `x_k`, its `wi` pointing back to `x_j` along the path.
-    pub si_k: SurfaceInteraction,
-    /// The orientation of `x_k` (`None`: a curved boundary).
-    pub plane: Option<RoughPlane>,
-}
-
 /// The pending suffix when BSDF sampling at `s` (reached right after `x_j`) refracted out through a
 /// rough plane of `x_j`'s boundary; `None` otherwise.
 pub fn pending(
@@ -641,6 +404,7 @@ mod tests {
     use super::*;
     use crate::bsdf::microfacet::MicrofacetType;
     use crate::bsdf::rough_dielectric::RoughDielectric;
+    use crate::math::Frame;
     use crate::testing::chi2::{chi2_sphere, sidak};
 
     fn rough(kind: MicrofacetType, alpha: f32, eta: f32) -> Bsdf {

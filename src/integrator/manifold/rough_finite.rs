@@ -11,7 +11,7 @@
 //! the TRUE BSDF at `x_k` (its own shading frame) and the real emitter direction
 //! `omega_l = (y − x_k)/|y − x_k|`, with the light segment `x_k → y` through passable surfaces.
 //!
-//! Density, in the measure of the other techniques (`rough::rough_pdfs`: solid angle of `omega_jk`
+//! Density, in the measure of the other techniques (`rough_lobe::rough_pdfs`: solid angle of `omega_jk`
 //! at `x_j` times solid angle of `omega_l` at `x_k`), conditioned on `x_j`:
 //!
 //! ```text
@@ -22,12 +22,12 @@
 //! `cos θ_y` at `y` with the light's normal there, computed from `y` itself for a sphere
 //! ([`light_normal`]) so that every place that evaluates `p_man` gets the same number. The
 //! estimate is `f_p T(d_jk) f_s(x_k; ω_kj → ω_l) L_e(y) tr / p_man`, MIS-weighted by
-//! `rough::rough_weight` over the four techniques (this, forward NEE at `x_k`, forward BSDF
+//! `rough_lobe::rough_weight` over the four techniques (this, forward NEE at `x_k`, forward BSDF
 //! sampling at `x_k` hitting the light, SNEE), computed from the same densities at the four places
 //! ([`sample_plane`], [`nee_weight`], [`bsdf_hit_weight`], [`snee_weight`]).
 
 use super::planes::RoughPlane;
-use super::rough::{self, on_boundary, on_plane, Reference, RoughPdfs, RoughTechnique, REFINE_STEPS};
+use super::rough_lobe::{self, on_boundary, on_plane, Reference, RoughPdfs, RoughTechnique, REFINE_STEPS};
 use super::MediumVertex;
 use crate::bsdf::fresnel::{fresnel, refract};
 use crate::bsdf::{Bsdf, BsdfContext};
@@ -145,7 +145,7 @@ fn eta_of(bsdf: &Bsdf) -> f32 {
 ///   direction towards `y` is refracted smoothly about `P`'s normal and followed back from `p_j`;
 ///   its first hit, if on `P`, gives the next point, and `omega_ref` is the direction from the
 ///   last point reached towards `y`.
-/// - `plane = None` (curved): as `rough::curved_reference` with `omega_l` replaced at each point by
+/// - `plane = None` (curved): as `rough_lobe::curved_reference` with `omega_l` replaced at each point by
 ///   the direction towards `y`: `x_0` = first hit of `(p_j, y − p_j)` (must be the enclosing
 ///   rough boundary met from inside, else `None`: density 0 for every suffix from `p_j` to `y`),
 ///   then refine; the reference is the last point's shading frame and BSDF.
@@ -229,7 +229,7 @@ pub fn density(
         return 0.0;
     }
     let Some((r, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else { return 0.0 };
-    let p_imp = rough::pdf_inner_in(&scene.bsdfs[r.bsdf as usize], r.frame, omega_ref, omega_jk);
+    let p_imp = rough_lobe::pdf_inner_in(&scene.bsdfs[r.bsdf as usize], r.frame, omega_ref, omega_jk);
     combine(p_y, p_imp, si_k, end)
 }
 
@@ -244,7 +244,7 @@ pub fn light_record(scene: &Scene, si_k: &SurfaceInteraction, end: &LightEnd) ->
     LightSample::hit(d, end.y, dist, scene.pdf_emitter_direction(si_k.p, &ds))
 }
 
-/// The four densities of the suffix (`rough::rough_pdfs` with the connection's `p_man`).
+/// The four densities of the suffix (`rough_lobe::rough_pdfs` with the connection's `p_man`).
 #[allow(clippy::too_many_arguments)]
 fn pdfs(
     scene: &Scene,
@@ -258,7 +258,7 @@ fn pdfs(
     check_support: bool,
     stats: &mut LocalStats,
 ) -> RoughPdfs {
-    let p = rough::rough_pdfs(scene, opts, x_i, x_j, path, None, light, channel, check_support, stats);
+    let p = rough_lobe::rough_pdfs(scene, opts, x_i, x_j, path, None, light, channel, check_support, stats);
     RoughPdfs { manifold, ..p }
 }
 
@@ -307,7 +307,7 @@ pub fn connect(
         return fail(stats);
     };
     let bsdf_ref = &scene.bsdfs[reference.bsdf as usize];
-    let omega_jk = rough::sample_inner_in(bsdf_ref, reference.frame, omega_ref, u1, u2)?;
+    let omega_jk = rough_lobe::sample_inner_in(bsdf_ref, reference.frame, omega_ref, u1, u2)?;
     stats.rays += 1;
     let hit = |si: &SurfaceInteraction| match plane {
         Some(plane) => on_plane(scene, si, x_j.medium, omega_jk, plane),
@@ -327,7 +327,7 @@ pub fn connect(
     if tr == Spectrum::ZERO || le == Spectrum::ZERO {
         return fail(stats);
     }
-    let p_imp = rough::pdf_inner_in(bsdf_ref, reference.frame, omega_ref, omega_jk);
+    let p_imp = rough_lobe::pdf_inner_in(bsdf_ref, reference.frame, omega_ref, omega_jk);
     let p_man = combine(p_y, p_imp, &si_k, &end);
     if !(p_man > 0.0) {
         return fail(stats);
@@ -338,7 +338,7 @@ pub fn connect(
     let m = &scene.media[x_j.medium as usize];
     let f = m.phase.eval(x_j.wi, omega_jk) * m.transmittance(si_k.t) * f_s * le * tr;
     let p = pdfs(scene, opts, x_i, x_j, (&si_k, omega_jk, si_k.t), &light, p_man, channel, true, stats);
-    let weight = rough::rough_weight(opts, RoughTechnique::Manifold, p);
+    let weight = rough_lobe::rough_weight(opts, RoughTechnique::Manifold, p);
     let value = f * (weight / p_man) as f32;
     Some(FiniteRoughConnection { value, weight, si_k, omega_jk, end, light, pdfs: p })
 }
@@ -361,7 +361,7 @@ pub fn nee_weight(
     let light = LightSample::sampled(ds);
     let p_man = density(scene, plane, x_j, omega_jk, si_k, &end, stats);
     let p = pdfs(scene, opts, x_i, x_j, (si_k, omega_jk, d_jk), &light, p_man, channel, true, stats);
-    Some(rough::rough_weight(opts, RoughTechnique::FwdNee, p) as f32)
+    Some(rough_lobe::rough_weight(opts, RoughTechnique::FwdNee, p) as f32)
 }
 
 /// The weight of forward BSDF sampling for a path that left through the rough `x_k` right after
@@ -370,7 +370,7 @@ pub fn nee_weight(
 pub fn bsdf_hit_weight(
     scene: &Scene,
     opts: SneeOptions,
-    rp: &rough::RoughPending,
+    rp: &rough_lobe::RoughPending,
     hit: &SurfaceInteraction,
     channel: usize,
     stats: &mut LocalStats,
@@ -383,7 +383,7 @@ pub fn bsdf_hit_weight(
     let p_man = density(scene, rp.plane.as_ref(), &rp.x_j, omega_jk, si_k, &end, stats);
     let x_i = rp.x_i.as_ref();
     let p = pdfs(scene, opts, x_i, &rp.x_j, (si_k, omega_jk, d_jk), &light, p_man, channel, true, stats);
-    Some(rough::rough_weight(opts, RoughTechnique::FwdBsdf, p) as f32)
+    Some(rough_lobe::rough_weight(opts, RoughTechnique::FwdBsdf, p) as f32)
 }
 
 /// SNEE's weight for a suffix it made through a rough `x_k` (on `plane`) towards the point
@@ -414,5 +414,5 @@ pub fn snee_weight(
     let p_man = density(scene, plane, &x_j, omega_jk, &s.si_k, &end, &mut no_rays);
     let path = (&s.si_k, omega_jk, d_jk);
     let p = pdfs(scene, opts, Some(&s.x_i), &x_j, path, light, p_man, channel, false, &mut no_rays);
-    Some(rough::rough_weight(opts, RoughTechnique::Snee, p))
+    Some(rough_lobe::rough_weight(opts, RoughTechnique::Snee, p))
 }
