@@ -31,7 +31,7 @@ use std::time::Instant;
 const TILE: u32 = 16;
 /// Most bytes of tile blocks held at once when several passes render together (`render_range`):
 /// small and medium films fuse all their passes, large ones (over 32 MB of blocks per pass) render
-/// pass by pass as before.
+/// pass by pass, one parallel loop each.
 const FUSED_BLOCK_BYTES: usize = 64 << 20;
 
 #[derive(Clone, Debug, Default)]
