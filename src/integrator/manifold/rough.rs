@@ -47,7 +47,7 @@ use crate::integrator::snee::SneeVertex;
 use crate::integrator::snee::{with_wi, LightSample, SneeOptions, SneeSuffix, SneeTechnique};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
-use crate::math::{Ray, Vec2, Vec3};
+use crate::math::{Vec2, Vec3};
 use crate::scene::world::Scene;
 use crate::shape::Geometry;
 
@@ -56,7 +56,7 @@ pub use super::rough_lobe::{
     curved_reference, pdf_inner, pdf_inner_in, rough_pdfs, rough_weight, sample_inner, sample_inner_in, Reference,
     RoughPdfs, RoughPending, RoughTechnique,
 };
-use super::rough_lobe::{on_boundary, on_plane};
+use super::rough_lobe::{on_boundary, on_plane, trace_inner};
 
 /// Per medium of `scene`: its rough boundary, or `None` (no emitter, the medium does not sample
 /// emitters, or some enclosing shape is not a mesh or sphere with an isotropic `roughdielectric`).
@@ -174,17 +174,9 @@ fn connect(
     stats: &mut LocalStats,
 ) -> Option<RoughConnection> {
     let omega_jk = sample_inner_in(&scene.bsdfs[reference.bsdf as usize], reference.frame, omega_l, u1, u2)?;
-    stats.rays += 1;
-    let hit = |si: &SurfaceInteraction| match plane {
-        Some(plane) => on_plane(scene, si, x_j.medium, omega_jk, plane),
-        None => on_boundary(scene, si, x_j.medium, omega_jk),
-    };
-    let si_k = match scene.ray_intersect(&Ray::new(x_j.p, omega_jk)) {
-        Some(si) if hit(&si) => si,
-        _ => {
-            stats.manifold_failures += 1;
-            return None;
-        }
+    let Some(si_k) = trace_inner(scene, x_j, plane, omega_jk, stats) else {
+        stats.manifold_failures += 1;
+        return None;
     };
     let tr = light_segment(scene, &si_k, omega_l, stats);
     if tr == Spectrum::ZERO {

@@ -308,14 +308,8 @@ pub fn connect(
     };
     let bsdf_ref = &scene.bsdfs[reference.bsdf as usize];
     let omega_jk = rough_lobe::sample_inner_in(bsdf_ref, reference.frame, omega_ref, u1, u2)?;
-    stats.rays += 1;
-    let hit = |si: &SurfaceInteraction| match plane {
-        Some(plane) => on_plane(scene, si, x_j.medium, omega_jk, plane),
-        None => on_boundary(scene, si, x_j.medium, omega_jk),
-    };
-    let si_k = match scene.ray_intersect(&Ray::new(x_j.p, omega_jk)) {
-        Some(si) if hit(&si) => si,
-        _ => return fail(stats),
+    let Some(si_k) = rough_lobe::trace_inner(scene, x_j, plane, omega_jk, stats) else {
+        return fail(stats);
     };
     let light = light_record(scene, &si_k, &end);
     // In front of the (one-sided) emitter, and seen from x_k through passable surfaces only.

@@ -135,6 +135,24 @@ pub fn pdf_inner_in(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, omega_jk: Vec3) ->
     }
 }
 
+/// The first hit from `x_j` along `omega_jk` (one ray, counted) when it is a point of `x_j`'s rough
+/// boundary met from inside: on `plane` (flat) or anywhere on a curved boundary (`plane = None`).
+pub(super) fn trace_inner(
+    scene: &Scene,
+    x_j: &MediumVertex,
+    plane: Option<&RoughPlane>,
+    omega_jk: Vec3,
+    stats: &mut LocalStats,
+) -> Option<SurfaceInteraction> {
+    stats.rays += 1;
+    let si = scene.ray_intersect(&Ray::new(x_j.p, omega_jk))?;
+    let on = match plane {
+        Some(plane) => on_plane(scene, &si, x_j.medium, omega_jk, plane),
+        None => on_boundary(scene, &si, x_j.medium, omega_jk),
+    };
+    on.then_some(si)
+}
+
 /// Is `si` (hit from inside `medium` along `d`) on the orientation `plane` of its rough boundary?
 pub(super) fn on_plane(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3, plane: &RoughPlane) -> bool {
     let s = &scene.shapes[si.shape as usize];
