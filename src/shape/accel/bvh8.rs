@@ -23,6 +23,17 @@ pub struct Node8 {
 }
 
 impl Node8 {
+    /// The row of `bounds` starting at offset `off` (8 × row index) of the bounds read as one array.
+    ///
+    /// # Safety
+    /// `off` must be a multiple of 8 below 48 (as `NodeRay` stores its rows).
+    #[inline(always)]
+    pub unsafe fn row(&self, off: usize) -> *const f32 {
+        debug_assert!(off.is_multiple_of(8) && off < 48);
+        // SAFETY: by the caller's contract, the 8 floats from `off` lie inside `bounds`.
+        unsafe { self.bounds.as_ptr().cast::<f32>().add(off) }
+    }
+
     pub const UNUSED: Node8 = Node8 {
         bounds: [
             [f32::INFINITY; 8],

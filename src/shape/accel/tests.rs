@@ -164,7 +164,7 @@ fn trace_ray_setup_equals_scalar() {
         assert_eq!(tr.node.inv_d.map(f32::to_bits), want_inv, "{d:?}");
         for a in 0..3 {
             let neg = (d0[a] < 0.0) as usize;
-            assert_eq!((tr.node.near[a], tr.node.far[a]), (2 * a + neg, 2 * a + 1 - neg), "{d:?}");
+            assert_eq!((tr.node.near[a], tr.node.far[a]), (8 * (2 * a + neg), 8 * (2 * a + 1 - neg)), "{d:?}");
         }
         let (k, sh) = triangle::shear_axes(d);
         let want = WatertightRay::from_parts(k, sh, o);

@@ -22,7 +22,9 @@ const FAR_SCALE: f32 = 1.000_000_4;
 pub struct NodeRay {
     pub o: [f32; 3],
     pub inv_d: [f32; 3],
-    /// Row of `Node8::bounds` holding the near (entry) plane per axis, and the far one.
+    /// Where the row of `Node8::bounds` holding the near (entry) plane per axis starts in the
+    /// bounds read as one array of 48 floats (8 × row; [`Node8::row`]), and the far one's: an offset
+    /// the node test adds to the node's address as it is, with no scaling per visit.
     pub near: [usize; 3],
     pub far: [usize; 3],
 }
@@ -43,12 +45,13 @@ impl NodeRay {
         let finite = inv.abs().cmplt(Vec4::splat(f32::INFINITY));
         let inv_d = Vec4::select(finite, inv, Vec4::splat(f32::MAX).copysign(d0));
         let neg = d0.cmplt(Vec4::ZERO).bitmask() as usize;
-        let (nx, ny, nz) = (neg & 1, (neg >> 1) & 1, (neg >> 2) & 1);
+        // 8 × (row of the near plane): the axis's min row (2a), or its max row when d[a] < 0.
+        let (nx, ny, nz) = ((neg & 1) << 3, (neg & 2) << 2, (neg & 4) << 1);
         NodeRay {
             o: o.to_array(),
             inv_d: inv_d.truncate().to_array(),
-            near: [nx, 2 + ny, 4 + nz],
-            far: [1 - nx, 3 - ny, 5 - nz],
+            near: [nx, 16 + ny, 32 + nz],
+            far: [8 - nx, 24 - ny, 40 - nz],
         }
     }
 }
@@ -76,7 +79,7 @@ impl TraceRay {
 pub fn node_test_portable(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f32; 8]) -> u32 {
     let mut mask = 0;
     for h in 0..2 {
-        let row = |i: usize| Vec4::from_slice(&node.bounds[i][4 * h..4 * h + 4]);
+        let row = |off: usize| Vec4::from_slice(&node.bounds.as_flattened()[off + 4 * h..off + 4 * h + 4]);
         let slab = |a: usize| {
             let (o, inv) = (Vec4::splat(r.o[a]), Vec4::splat(r.inv_d[a]));
             ((row(r.near[a]) - o) * inv, (row(r.far[a]) - o) * inv)
@@ -103,8 +106,9 @@ macro_rules! node_test_avx_body {
             ($a:expr) => {{
                 let o = _mm256_set1_ps(r.o[$a]);
                 let inv = _mm256_set1_ps(r.inv_d[$a]);
-                let near = _mm256_loadu_ps(node.bounds[r.near[$a]].as_ptr());
-                let far = _mm256_loadu_ps(node.bounds[r.far[$a]].as_ptr());
+                // SAFETY: `r.near`/`r.far` are row offsets as `NodeRay::with_inverse` sets them.
+                let near = _mm256_loadu_ps(unsafe { node.row(r.near[$a]) });
+                let far = _mm256_loadu_ps(unsafe { node.row(r.far[$a]) });
                 (_mm256_mul_ps(_mm256_sub_ps(near, o), inv), _mm256_mul_ps(_mm256_sub_ps(far, o), inv))
             }};
         }
@@ -122,7 +126,7 @@ macro_rules! node_test_avx_body {
 /// The AVX slab test as a function (for tests).
 ///
 /// # Safety
-/// The CPU must support AVX.
+/// The CPU must support AVX, and `r` must come from [`NodeRay::new`] or [`NodeRay::with_inverse`].
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 pub unsafe fn node_test_avx(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f32; 8]) -> u32 {

@@ -58,7 +58,8 @@ pub fn shear_axes(d: Vec3) -> ([usize; 3], [f32; 3]) {
 /// Per-ray precomputation of the watertight test (Woop et al. 2013, Sec. 3).
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    /// Axes (kx, ky, kz).
+    /// Axes (kx, ky, kz), each as 4 × axis: where the axis's row starts in a vertex's
+    /// `[[f32; 4]; 3]` read as one array (so a visit adds it to the address as it is).
     k: [usize; 3],
     /// Shear (sx, sy, sz), splatted.
     s: [Vec4; 3],
@@ -70,9 +71,12 @@ pub struct WatertightRay {
 #[inline(always)]
 fn sheared(w: &WatertightRay, p: &TriPacket4, j: usize) -> (Vec4, Vec4, Vec4) {
     let v = &p.v[j];
-    let rx = Vec4::from_array(v[w.k[0]]) - w.o[0];
-    let ry = Vec4::from_array(v[w.k[1]]) - w.o[1];
-    let rz = Vec4::from_array(v[w.k[2]]) - w.o[2];
+    // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse`),
+    // so the four floats from each offset are one row of `v`.
+    let row = |k: usize| unsafe { Vec4::from_array(*v.as_ptr().cast::<f32>().add(k).cast::<[f32; 4]>()) };
+    let rx = row(w.k[0]) - w.o[0];
+    let ry = row(w.k[1]) - w.o[1];
+    let rz = row(w.k[2]) - w.o[2];
     (rx - w.s[0] * rz, ry - w.s[1] * rz, w.s[2] * rz)
 }
 
@@ -85,7 +89,8 @@ impl WatertightRay {
 
     /// The test's state from axes `k` and shear `s` as [`shear_axes`] gives them.
     pub fn from_parts(k: [usize; 3], s: [f32; 3], o: Vec3) -> Self {
-        WatertightRay { k, s: s.map(Vec4::splat), o: k.map(|a| Vec4::splat(o[a])) }
+        assert!(k.iter().all(|&a| a < 3), "axes {k:?}");
+        WatertightRay { k: k.map(|a| 4 * a), s: s.map(Vec4::splat), o: k.map(|a| Vec4::splat(o[a])) }
     }
 
     /// [`WatertightRay::new`] given `inv` = 1 / (d + 0) per axis (the node test's unclamped inverse,
@@ -106,7 +111,7 @@ impl WatertightRay {
         }
         let sz = inv[kz];
         WatertightRay {
-            k: [kx, ky, kz],
+            k: [4 * kx, 4 * ky, 4 * kz],
             s: [Vec4::splat(d[kx] * sz), Vec4::splat(d[ky] * sz), Vec4::splat(sz)],
             o: [Vec4::splat(o[kx]), Vec4::splat(o[ky]), Vec4::splat(o[kz])],
         }
