@@ -27,7 +27,9 @@ pub use super::cx::{Cx, EmitterHit, Scatter, Stages};
 use super::manifold::ManifoldStage;
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
-use super::walk::{free_flight, is_medium_transition, shadow_ray, target_medium, PathSetup, RefPoint, MAX_SEGMENTS};
+use super::walk::{
+    free_flight, is_medium_transition, shadow_crossing, shadow_ray, target_medium, PathSetup, RefPoint, MAX_SEGMENTS,
+};
 use crate::bsdf::{flags, BsdfContext};
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::color::Spectrum;
@@ -99,8 +101,9 @@ pub fn shadow_transmittance(
         // Up to and including `t`: a surface exactly at `t` is crossed, as with `t < seg` below.
         ray.tmax = if t < remaining { t.next_up() } else { remaining };
         stats.rays += 1;
-        let si = scene.ray_intersect(&ray);
-        let seg = si.as_ref().map_or(remaining, |s| s.t);
+        // The hit alone (`Scene::ray_intersect`'s query); the crossing below builds what it needs of it.
+        let hit = scene.accel.intersect_inline(&scene.shapes, &ray);
+        let seg = hit.as_ref().map_or(remaining, |h| h.t);
         if let Some(m) = m {
             if t < seg {
                 // A real collision: homogeneous media have no null density, the estimate is 0.
@@ -115,16 +118,19 @@ pub fn shadow_transmittance(
                 tr *= t_seg / p;
             }
         }
-        let Some(si) = si else { break };
-        tr *= scene.bsdf(&si).eval_null_transmission(&si);
+        let Some(hit) = hit else { break };
+        let (p, n, null_transmission) = shadow_crossing(scene, &hit, &ray);
+        tr *= null_transmission;
         if tr == Spectrum::ZERO {
             break;
         }
-        if is_medium_transition(scene, &si) {
-            medium = target_medium(scene, &si, ray.d);
+        // `is_medium_transition` and `target_medium` on the crossing's shape and normal.
+        let s = &scene.shapes[hit.shape as usize];
+        if s.interior.is_some() || s.exterior.is_some() {
+            medium = if ray.d.dot(n) > 0.0 { s.exterior } else { s.interior };
         }
-        remaining -= si.t;
-        ray.o = offset_origin(si.p, si.n, ray.d);
+        remaining -= hit.t;
+        ray.o = offset_origin(p, n, ray.d);
     }
     tr
 }

@@ -9,11 +9,15 @@
 //! - [`PathSetup`]: the settings every path starts from (depth limits, hero channel).
 
 use super::stats::LocalStats;
+use crate::bsdf::Bsdf;
+use crate::color::Spectrum;
 use crate::interaction::{offset_origin, spawn_ray_between, DirectionSample, SurfaceInteraction};
 use crate::math::{Ray, Vec3};
 use crate::medium::Homogeneous;
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
+use crate::shape::accel::Hit;
+use crate::shape::Geometry;
 
 /// Upper bound on the surfaces one walk crosses (guards against degenerate geometry).
 pub const MAX_SEGMENTS: u32 = 256;
@@ -169,4 +173,25 @@ pub fn shadow_ray(scene: &Scene, r: RefPoint, medium: Option<u32>, ds: &Directio
     };
     let ray = if ds.dist.is_finite() { spawn_ray_between(o, ds.p) } else { Ray::new(o, ds.d) };
     (ray, medium)
+}
+
+/// Where a shadow ray crosses the surface of `hit` (found along `ray`): the point, the geometric
+/// normal, and the surface's null transmission (Mitsuba's `eval_null_transmission`), which is all a
+/// shadow walk needs of it. A mesh with a `null` BSDF (an index-matched medium boundary) transmits 1
+/// and needs only the point and the face normal, computed here with `Mesh::interaction`'s
+/// operations (so the same bits) without its shading frame; anything else gets the full
+/// `SurfaceInteraction`.
+#[inline]
+pub fn shadow_crossing(scene: &Scene, hit: &Hit, ray: &Ray) -> (Vec3, Vec3, Spectrum) {
+    let shape = &scene.shapes[hit.shape as usize];
+    if let (Geometry::Mesh(m), Bsdf::Null) = (&shape.geometry, &scene.bsdfs[shape.bsdf as usize]) {
+        let [p0, p1, p2] = m.indices[hit.prim as usize].map(|i| m.positions[i as usize]);
+        let b0 = 1.0 - hit.b1 - hit.b2;
+        let p = p0 * b0 + p1 * hit.b1 + p2 * hit.b2;
+        let face_n = m.face_normals[hit.prim as usize];
+        return (p, if m.flip_normals { -face_n } else { face_n }, Spectrum::ONE);
+    }
+    let mut si = shape.interaction(hit.prim, hit.b1, hit.b2, hit.t, ray);
+    si.shape = hit.shape;
+    (si.p, si.n, scene.bsdf(&si).eval_null_transmission(&si))
 }
