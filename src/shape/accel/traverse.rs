@@ -158,11 +158,33 @@ pub const STACK: usize = 128;
 /// A traversal stack of `n` entries; only written entries are ever read.
 pub type Stack = [MaybeUninit<Entry>];
 
+/// Element `$i` of `$v` by reference: bounds-checked (`checked`), or not (`unchecked`: only in
+/// the AVX2 traversal, whose safety contract guarantees every index: a tree as `build::build`
+/// makes it and a stack of `stack_size(depth)` entries).
+macro_rules! at {
+    (checked, $v:expr, $i:expr) => {
+        &$v[$i]
+    };
+    (unchecked, $v:expr, $i:expr) => {
+        unsafe { $v.get_unchecked($i) }
+    };
+}
+
+/// [`at!`] for writing.
+macro_rules! at_mut {
+    (checked, $v:expr, $i:expr) => {
+        &mut $v[$i]
+    };
+    (unchecked, $v:expr, $i:expr) => {
+        unsafe { $v.get_unchecked_mut($i) }
+    };
+}
+
 /// Closest-hit traversal with node test `$node_test`: `(lane index into lane_prims, t, b1, b2)`
 /// of the nearest triangle in (0, tmax). A macro, so that each instance is compiled with the
 /// target features of the function it expands in and the node test inlines.
 macro_rules! closest_body {
-    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident) => {{
+    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident, $chk:ident) => {{
         let (bvh, mut tmax, stack): (&Bvh8, f32, &mut Stack) = ($bvh, $tmax, $stack);
         let tr = TraceRay::new($o, $d);
         let (nr, wt) = (&tr.node, &tr.wt);
@@ -173,7 +195,7 @@ macro_rules! closest_body {
         'traversal: loop {
             // Descend through inner nodes to the nearest hit child until a leaf (or nothing) is next.
             while cur & LEAF == 0 {
-                let node = &bvh.nodes[cur as usize];
+                let node = at!($chk, bvh.nodes, cur as usize);
                 let mut mask = $node_test!(node, nr, tmax, &mut t_near);
                 if mask == 0 {
                     cur = EMPTY;
@@ -192,7 +214,7 @@ macro_rules! closest_body {
                     // Exactly two (the most common case): one comparison.
                     let (a, b) = (key(first), key(rest.trailing_zeros()));
                     let (near, far) = if a < b { (a, b) } else { (b, a) };
-                    stack[sp] =
+                    *at_mut!($chk, stack, sp) =
                         MaybeUninit::new(Entry { child: node.child[(far & 7) as usize], t: f32::from_bits(far & !7) });
                     sp += 1;
                     cur = node.child[(near & 7) as usize];
@@ -213,7 +235,7 @@ macro_rules! closest_body {
                     n += 1;
                 }
                 for &key in &keys[..n - 1] {
-                    stack[sp] =
+                    *at_mut!($chk, stack, sp) =
                         MaybeUninit::new(Entry { child: node.child[(key & 7) as usize], t: f32::from_bits(key & !7) });
                     sp += 1;
                 }
@@ -221,7 +243,7 @@ macro_rules! closest_body {
             }
             if cur != EMPTY {
                 let packet = (cur & !LEAF) as usize;
-                if let Some((lane, t, b1, b2)) = wt.nearest4(&bvh.packets[packet], tmax) {
+                if let Some((lane, t, b1, b2)) = wt.nearest4(at!($chk, bvh.packets, packet), tmax) {
                     tmax = t;
                     found = Some(((4 * packet + lane) as u32, t, b1, b2));
                 }
@@ -233,7 +255,8 @@ macro_rules! closest_body {
                 }
                 sp -= 1;
                 // SAFETY: entries below `sp` were written.
-                let e = unsafe { stack[sp].assume_init() };
+                let e = *at!($chk, stack, sp);
+                let e = unsafe { e.assume_init() };
                 if e.t <= tmax {
                     cur = e.child;
                     break;
@@ -245,7 +268,7 @@ macro_rules! closest_body {
 
 /// Any-hit traversal with node test `$node_test`: true when a triangle is hit in (0, tmax).
 macro_rules! any_body {
-    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident) => {{
+    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident, $chk:ident) => {{
         let (bvh, tmax, stack): (&Bvh8, f32, &mut Stack) = ($bvh, $tmax, $stack);
         let tr = TraceRay::new($o, $d);
         let (nr, wt) = (&tr.node, &tr.wt);
@@ -254,7 +277,7 @@ macro_rules! any_body {
         let mut t_near = [0.0f32; 8];
         loop {
             if cur & LEAF == 0 {
-                let node = &bvh.nodes[cur as usize];
+                let node = at!($chk, bvh.nodes, cur as usize);
                 let mut mask = $node_test!(node, nr, tmax, &mut t_near);
                 if mask != 0 {
                     // Descend into the hit child of the highest slot; push the others (lowest
@@ -264,13 +287,13 @@ macro_rules! any_body {
                     while mask != 0 {
                         let slot = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        stack[sp] = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
+                        *at_mut!($chk, stack, sp) = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
                         sp += 1;
                     }
                     cur = node.child[last as usize];
                     continue;
                 }
-            } else if wt.any4(&bvh.packets[(cur & !LEAF) as usize], tmax) {
+            } else if wt.any4(at!($chk, bvh.packets, (cur & !LEAF) as usize), tmax) {
                 break true;
             }
             if sp == 0 {
@@ -278,29 +301,32 @@ macro_rules! any_body {
             }
             sp -= 1;
             // SAFETY: entries below `sp` were written.
-            cur = unsafe { stack[sp].assume_init() }.child;
+            let e = *at!($chk, stack, sp);
+            cur = unsafe { e.assume_init() }.child;
         }
     }};
 }
 
 /// Closest hit, portable node test.
 pub fn closest_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
-    closest_body!(bvh, o, d, tmax, stack, node_test_portable_body)
+    closest_body!(bvh, o, d, tmax, stack, node_test_portable_body, checked)
 }
 
 /// Any hit, portable node test.
 pub fn any_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> bool {
-    any_body!(bvh, o, d, tmax, stack, node_test_portable_body)
+    any_body!(bvh, o, d, tmax, stack, node_test_portable_body, checked)
 }
 
 /// Closest hit, AVX node test.
 ///
 /// # Safety
-/// The CPU must support AVX2, BMI1, LZCNT and POPCNT (`Isa::detect`).
+/// The CPU must support AVX2, BMI1, LZCNT and POPCNT (`Isa::detect`); `bvh` must be as
+/// `build::build` makes it (every child and packet index in range, `depth` its depth) and `stack`
+/// hold at least `stack_size(bvh.depth)` entries: the traversal indexes both without bounds checks.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
 pub unsafe fn closest_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
-    closest_body!(bvh, o, d, tmax, stack, node_test_avx_body)
+    closest_body!(bvh, o, d, tmax, stack, node_test_avx_body, unchecked)
 }
 
 /// Any hit, AVX node test.
@@ -310,5 +336,5 @@ pub unsafe fn closest_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
 pub unsafe fn any_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> bool {
-    any_body!(bvh, o, d, tmax, stack, node_test_avx_body)
+    any_body!(bvh, o, d, tmax, stack, node_test_avx_body, unchecked)
 }
