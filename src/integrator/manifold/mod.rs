@@ -33,6 +33,7 @@
 //! ([`Snee::flat`], read through [`tables`]).
 
 pub mod chain;
+pub mod chain_seed;
 pub mod curved;
 pub mod curved_finite;
 pub mod finite;
