@@ -75,6 +75,8 @@ pub enum End<'a> {
     Snee,
     /// The manifold connection from the current medium vertex `x_j`: V–S_t–L.
     Manifold,
+    /// The two-vertex chain from the current medium vertex (reflection, refraction): V–S_r–S_t–L.
+    Chain,
     /// An emitter hit by the path's ray (after the surface events seen so far).
     Hit,
     /// Emitter sampling at the surface `s` the ray along `d` reached, towards `light_d`.
@@ -233,6 +235,7 @@ impl Tally for Classes {
                 (_, Vertex::Medium { .. }) => PathClass::SneeSupport,
                 _ => PathClass::SurfaceBeforeLast,
             },
+            End::Chain => PathClass::InternalReflection,
             End::Hit => {
                 let mut x_k = self.x_k.take();
                 let class = self.classify(scene, self.after, self.last_transmission, x_k.as_mut());

@@ -493,6 +493,9 @@ pub fn trace<W: PathWeight, T: Tally>(
                         let c = manifold.at_scatter(cx, snee, &v);
                         result += c;
                         tally.add(scene, c, End::Manifold);
+                        let c = manifold.chain_at_scatter(cx, &v);
+                        result += c;
+                        tally.add(scene, c, End::Chain);
                     }
                 }
 

@@ -10,8 +10,9 @@
 //!   = lim E ∫ f_p T F (1 − F) η² 1[angle(o(ω), ω_l) < θ] dω / Ω(θ)
 //! ```
 //!
-//! Sample counts fixed before the first run: 2²² cone directions (θ = 0.03 rad) and 4096
-//! connections per vertex; agreement within 4 combined standard errors.
+//! `chain::connect` seeds from the light side (`chain_seed.rs`, mixed with uniform directions) and
+//! caps its Bernoulli trials at 4096. Sample counts fixed before the first run: 2²² cone directions
+//! (θ = 0.03 rad) and 4096 connections per vertex; agreement within 4 combined standard errors.
 
 use crate::common;
 use snee::bsdf::fresnel::fresnel;
@@ -97,4 +98,76 @@ fn chain_connect_matches_the_cone_limit_in_a_glass_ball() {
         stats.chain_solves, stats.chain_iterations, stats.chain_solutions, stats.chain_trials_capped
     );
     assert_eq!(stats.rejected_samples, 0);
+}
+
+/// On the paper's statue (σt from `STATUE_SIGMA_T`, default 2; its light), at medium vertices
+/// uniform in the medium: the distinct chain solutions that 1024 uniform seeds and 1024 light-side
+/// seeds (`chain_seed.rs`) each reach, the convergence rates, and each distribution's probability
+/// of the solutions weighted by their geometric weight `F (1 − F) η² |det|⁻¹ T`. Ignored: a
+/// measurement (docs/manifold.md §9), not a check.
+#[test]
+#[ignore]
+fn diagnose_statue_chain_seeds() {
+    use crate::manifold_curved_statue::{inside_point, statue};
+    use snee::integrator::manifold::chain_seed::{self, ChainSeeds};
+    let sigma_t: f64 = std::env::var("STATUE_SIGMA_T").ok().and_then(|s| s.parse().ok()).unwrap_or(2.0);
+    let scene = statue(&sigma_t.to_string());
+    let (ds, _) = scene.sample_emitter_direction(Vec3::ZERO, None, snee::math::Vec2::new(0.5, 0.5), false);
+    let omega_l = ds.d.as_dvec3().normalize();
+    let mut rng = Sampler::new(5, 1);
+    let mut u = move || rng.next_1d() as f64;
+    let points: usize = std::env::var("STATUE_POINTS").ok().and_then(|s| s.parse().ok()).unwrap_or(100);
+    const SEEDS: usize = 1024;
+    let kinds = [ChainSeeds::Uniform, ChainSeeds::LightSide];
+    let mut converged = [0u64; 2];
+    let mut weight_p = [0.0f64; 2];
+    let (mut total_weight, mut n_solutions, mut with_solutions) = (0.0f64, 0usize, 0usize);
+    let mut only = [0usize; 2];
+    let mut only_weight = [0.0f64; 2];
+    for _ in 0..points {
+        let p = inside_point(&scene, &mut u).as_dvec3();
+        let mut locate = chain::SceneChain { scene: &scene, medium: 0, rays: 0 };
+        let mut found: Vec<(DVec3, f64, [u32; 2])> = Vec::new();
+        for (k, seeds) in kinds.into_iter().enumerate() {
+            for _ in 0..SEEDS {
+                let seed = chain_seed::draw(seeds, &mut locate, p, omega_l, &mut u);
+                let Ok(s) = chain::solve(&mut locate, p, omega_l, seed) else { continue };
+                converged[k] += 1;
+                if let Some(f) = found.iter_mut().find(|f| (f.0 - s.omega).length() < 1e-4) {
+                    f.2[k] += 1;
+                } else {
+                    let tr = (-sigma_t * (s.map.t_1 + s.map.out.t)).exp();
+                    let mut n = [0; 2];
+                    n[k] = 1;
+                    found.push((s.omega, chain::geometric_weight(&s) * tr, n));
+                }
+            }
+        }
+        with_solutions += !found.is_empty() as usize;
+        n_solutions += found.len();
+        for (_, w, n) in &found {
+            total_weight += w;
+            for k in 0..2 {
+                weight_p[k] += w * n[k] as f64 / SEEDS as f64;
+                if n[1 - k] == 0 {
+                    only[k] += 1;
+                    only_weight[k] += w;
+                }
+            }
+        }
+    }
+    let tried = (points * SEEDS) as f64;
+    eprintln!(
+        "σt {sigma_t}: {points} vertices, {with_solutions} with a solution, {n_solutions} distinct solutions; \
+         converged uniform {:.4} light-side {:.4}; weight-averaged p: uniform {:.3e} light-side {:.3e}; \
+         found only by uniform {} (weight share {:.3}), only by light-side {} (weight share {:.3})",
+        converged[0] as f64 / tried,
+        converged[1] as f64 / tried,
+        weight_p[0] / total_weight,
+        weight_p[1] / total_weight,
+        only[0],
+        only_weight[0] / total_weight,
+        only[1],
+        only_weight[1] / total_weight,
+    );
 }

@@ -25,11 +25,13 @@
 //! ```
 //!
 //! Several or no solutions: specular manifold sampling's unbiased `1/p` (Zeltner et al. 2020,
-//! §4.3), seeds uniform on the sphere of directions at `x_j` (every solution has a positive
-//! probability; no deterministic seed is known for a reflection point), Bernoulli trials capped at
-//! [`MAX_TRIALS`] (capped connections counted in `--stats` as `chain_trials_capped`).
+//! §4.3), seeds from the light side mixed with uniform directions (`chain_seed.rs`: every solution
+//! has a positive probability; no deterministic seed is known for a reflection point), Bernoulli
+//! trials capped at [`MAX_TRIALS`] (capped connections counted in `--stats` as
+//! `chain_trials_capped`).
 
-use super::newton::{bernoulli_trials, damped_step, moved, sphere_seed, tangents, Failure, Patch, Refracted};
+use super::chain_seed::{self, ChainSeeds};
+use super::newton::{bernoulli_trials_capped, damped_step, moved, tangents, Failure, Patch, Refracted};
 use super::MediumVertex;
 use crate::bsdf::fresnel::fresnel;
 use crate::color::Spectrum;
@@ -47,8 +49,10 @@ pub const MAX_ITERATIONS: u32 = 32;
 pub const TOLERANCE: f64 = 1e-8;
 /// Finite-difference step for the Jacobian (radians).
 const FD_STEP: f64 = 1e-6;
-/// Largest number of Bernoulli trials (SMS's cap, shared with the one-refraction connection).
-pub use super::newton::MAX_TRIALS;
+/// Largest number of Bernoulli trials (SMS's cap, as the one-refraction connection's, §8.1): a
+/// solution of probability `p` keeps the share `1 − (1 − p)^MAX_TRIALS` of its contribution, and the
+/// expected number of draws per connection stays below `1 + (number of solutions)` whatever the cap.
+pub const MAX_TRIALS: u32 = super::newton::DIRECTIONAL_MAX_TRIALS;
 
 /// Where the chain's rays meet the boundary (the caller's ray casts).
 pub trait ChainLocate {
@@ -191,18 +195,21 @@ pub struct ChainCounts {
 }
 
 /// Specular manifold sampling's unbiased estimate (Zeltner et al. 2020, §4.3) for the chain: one
-/// solution `s` from a seed uniform on the sphere at `x_j`, and the number `N` of seeds drawn until
-/// `s` is found again (`E[N | s] = 1/p(s)`, capped at [`MAX_TRIALS`]); `f(s) · N` estimates
-/// `Σ_s f(s)`.
+/// solution `s` from a seed drawn from `seeds` (`chain_seed.rs`), and the number `N` of seeds drawn
+/// from the same distribution until `s` is found again (`E[N | s] = 1/p(s)`, capped at `cap`);
+/// `f(s) · N` estimates `Σ_s f(s)`.
 pub fn sample_solution(
     locate: &mut impl ChainLocate,
     x_j: DVec3,
     omega_l: DVec3,
+    seeds: ChainSeeds,
+    cap: u32,
     u: &mut impl FnMut() -> f64,
     counts: &mut ChainCounts,
 ) -> Option<(ChainSolution, u32)> {
+    let omega_l = omega_l.normalize();
     let draw = |locate: &mut _, u: &mut dyn FnMut() -> f64, counts: &mut ChainCounts| {
-        let seed = sphere_seed(u(), u());
+        let seed = chain_seed::draw(seeds, locate, x_j, omega_l, u);
         let r = solve(locate, x_j, omega_l, seed);
         counts.solves += 1;
         match &r {
@@ -215,7 +222,7 @@ pub fn sample_solution(
         r.ok()
     };
     let s = draw(locate, u, counts)?;
-    let (n, capped) = bernoulli_trials(s.omega, || draw(locate, u, counts).map(|t| t.omega));
+    let (n, capped) = bernoulli_trials_capped(s.omega, cap, || draw(locate, u, counts).map(|t| t.omega));
     counts.capped += capped as u64;
     Some((s, n))
 }
@@ -228,11 +235,11 @@ pub fn geometric_weight(s: &ChainSolution) -> f64 {
     f_1 * (1.0 - f_2) * eta * eta * s.d_omega_d_omega_l
 }
 
-/// The scene as the chain's walk sees it.
-struct SceneChain<'a> {
-    scene: &'a Scene,
-    medium: u32,
-    rays: u64,
+/// The scene as the chain's walk sees it (rays cast in `medium`, counted in `rays`).
+pub struct SceneChain<'a> {
+    pub scene: &'a Scene,
+    pub medium: u32,
+    pub rays: u64,
 }
 
 impl ChainLocate for SceneChain<'_> {
@@ -271,7 +278,15 @@ pub fn connect(
     let mut locate = SceneChain { scene, medium: x_j.medium, rays: 0 };
     let mut counts = ChainCounts::default();
     let mut u = || sampler.next_1d() as f64;
-    let sampled = sample_solution(&mut locate, x_j.p.as_dvec3(), omega_l.as_dvec3(), &mut u, &mut counts);
+    let sampled = sample_solution(
+        &mut locate,
+        x_j.p.as_dvec3(),
+        omega_l.as_dvec3(),
+        ChainSeeds::LightSide,
+        MAX_TRIALS,
+        &mut u,
+        &mut counts,
+    );
     stats.rays += locate.rays;
     stats.chain_solves += counts.solves;
     stats.chain_iterations += counts.iterations;
@@ -343,7 +358,7 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, v: &Scatter) -> Spectrum {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrator::manifold::newton::Surface;
+    use crate::integrator::manifold::newton::{sphere_seed, Surface};
 
     /// The whole boundary is one analytic sphere (unit radius at the origin).
     struct Ball {
@@ -451,25 +466,71 @@ mod tests {
             }
             let cone_mean = sum / m as f64;
             let cone_se = ((sq / m as f64 - cone_mean * cone_mean) / m as f64).sqrt();
-            // SMS.
-            let mut counts = ChainCounts::default();
-            let runs = 4096;
-            let (mut s_sum, mut s_sq) = (0.0, 0.0);
-            for _ in 0..runs {
-                let e = sample_solution(&mut ball, x_j, omega_l, &mut u, &mut counts)
-                    .map_or(0.0, |(s, n)| geometric_weight(&s) * n as f64);
-                s_sum += e;
-                s_sq += e * e;
+            // SMS, with either seed distribution.
+            for seeds in [ChainSeeds::Uniform, ChainSeeds::LightSide] {
+                let mut counts = ChainCounts::default();
+                let runs = 4096;
+                let (mut s_sum, mut s_sq) = (0.0, 0.0);
+                for _ in 0..runs {
+                    let e = sample_solution(&mut ball, x_j, omega_l, seeds, MAX_TRIALS, &mut u, &mut counts)
+                        .map_or(0.0, |(s, n)| geometric_weight(&s) * n as f64);
+                    s_sum += e;
+                    s_sq += e * e;
+                }
+                let sms_mean = s_sum / runs as f64;
+                let sms_se = ((s_sq / runs as f64 - sms_mean * sms_mean) / runs as f64).sqrt();
+                let z = (sms_mean - cone_mean) / (sms_se * sms_se + cone_se * cone_se).sqrt();
+                eprintln!(
+                    "x_j {x_j:?} {seeds:?}: SMS {sms_mean:.5} ± {sms_se:.5}, cone limit {cone_mean:.5} ± \
+                     {cone_se:.5}, z {z:.2}; capped {} of {runs}; {counts:?}",
+                    counts.capped
+                );
+                assert!(z.abs() < 4.0, "{seeds:?}: SMS {sms_mean} ± {sms_se} vs cone limit {cone_mean} ± {cone_se}");
             }
-            let sms_mean = s_sum / runs as f64;
-            let sms_se = ((s_sq / runs as f64 - sms_mean * sms_mean) / runs as f64).sqrt();
-            let z = (sms_mean - cone_mean) / (sms_se * sms_se + cone_se * cone_se).sqrt();
+        }
+    }
+
+    /// Every chain solution on the glass ball (η = 1.5) that 4096 uniform seeds find is also found
+    /// by 4096 light-side seeds (`chain_seed.rs`), at the three points of the cone-limit test; the
+    /// light-side seeds' convergence rate is reported next to the uniform seeds'. Counts fixed before
+    /// the first run.
+    #[test]
+    fn light_side_seeds_find_every_solution_on_a_ball() {
+        let mut rng = crate::sampler::Sampler::new(17, 1);
+        let mut u = move || rng.next_1d() as f64;
+        let mut ball = Ball { eta: 1.5 };
+        for (x_j, omega_l) in [
+            (DVec3::new(0.1, -0.2, 0.3), DVec3::new(0.3, 0.2, 0.9)),
+            (DVec3::new(-0.5, 0.1, -0.2), DVec3::new(0.0, 0.0, 1.0)),
+            (DVec3::new(0.2, 0.6, -0.1), DVec3::new(-0.5, 0.6, 0.4)),
+        ] {
+            let omega_l = omega_l.normalize();
+            // Distinct solutions and how often each seed distribution reaches them.
+            let mut found: Vec<(DVec3, [u32; 2])> = Vec::new();
+            let mut converged = [0u32; 2];
+            let draws = 4096;
+            for (k, seeds) in [ChainSeeds::Uniform, ChainSeeds::LightSide].into_iter().enumerate() {
+                for _ in 0..draws {
+                    let seed = chain_seed::draw(seeds, &mut ball, x_j, omega_l, &mut u);
+                    let Ok(s) = solve(&mut ball, x_j, omega_l, seed) else { continue };
+                    converged[k] += 1;
+                    match found.iter_mut().find(|(o, _)| (*o - s.omega).length() < 1e-4) {
+                        Some((_, n)) => n[k] += 1,
+                        None => found.push((s.omega, if k == 0 { [1, 0] } else { [0, 1] })),
+                    }
+                }
+            }
             eprintln!(
-                "x_j {x_j:?}: SMS {sms_mean:.5} ± {sms_se:.5}, cone limit {cone_mean:.5} ± {cone_se:.5}, z {z:.2}; \
-                 capped {} of {runs}; {counts:?}",
-                counts.capped
+                "x_j {x_j:?}: {} solutions; converged uniform {} light-side {} of {draws}; per solution {:?}",
+                found.len(),
+                converged[0],
+                converged[1],
+                found.iter().map(|(_, n)| *n).collect::<Vec<_>>()
             );
-            assert!(z.abs() < 4.0, "SMS {sms_mean} ± {sms_se} vs cone limit {cone_mean} ± {cone_se}");
+            assert!(!found.is_empty());
+            for (o, n) in &found {
+                assert!(n[0] == 0 || n[1] > 0, "light-side seeds never reach the solution {o:?} ({n:?})");
+            }
         }
     }
 }

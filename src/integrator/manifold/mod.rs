@@ -33,6 +33,7 @@
 //! ([`Snee::flat`], read through [`tables`]).
 
 pub mod chain;
+pub mod chain_seed;
 pub mod curved;
 pub mod curved_finite;
 pub mod finite;
@@ -115,6 +116,21 @@ pub fn boundary_of(scene: &Scene, medium: u32) -> Option<&FlatBoundary> {
     tables(scene)?.flat.get(medium as usize)?.as_ref()
 }
 
+/// The two-vertex chain (reflection, then refraction; `reflection_chains`, docs/manifold.md §9) at
+/// a real scatter `v`, where the curved connection runs (after [`sample`]); zero elsewhere. Its
+/// suffix is V–S_r–S_t–L, the class `internal_reflection`.
+pub fn sample_chain(cx: &mut Cx, opts: SneeOptions, v: &Scatter) -> Spectrum {
+    let scene = cx.scene;
+    if !opts.chains
+        || !enabled(scene)
+        || rough::boundary_of(scene, v.medium).is_some()
+        || boundary_of(scene, v.medium).is_some()
+    {
+        return Spectrum::ZERO;
+    }
+    chain::sample(cx, opts, v)
+}
+
 /// Upper bound on the interfaces crossed by one light segment.
 const MAX_LIGHT_SEGMENTS: u32 = 64;
 
@@ -194,10 +210,9 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     let x_j = MediumVertex { p: v.p, wi: v.wi, medium: v.medium };
     let (beta, depth, max_depth) = (v.beta, v.depth, v.max_depth);
     let Some(boundary) = boundary_of(scene, x_j.medium) else {
-        // Curved boundary: one refraction, and with `reflection_chains` the two-vertex chain
-        // (reflection, refraction).
-        let one = curved::sample(cx, opts, x_i, v);
-        return if opts.chains { one.map(|r| r + chain::sample(cx, opts, v)) } else { one };
+        // Curved boundary: one refraction (with `reflection_chains` the two-vertex chain runs
+        // after it, [`sample_chain`], returned apart so that `--classes` tallies it apart).
+        return curved::sample(cx, opts, x_i, v);
     };
     let u: Vec2 = sampler.next_2d();
     // Same depth budget as forward tracing through x_k to an emitter (and as a SNEE vertex's).

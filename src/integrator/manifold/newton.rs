@@ -303,9 +303,8 @@ pub fn solve(locate: &mut impl Locate, x_j: DVec3, omega_l: DVec3, seed: DVec3) 
     Err((Failure::NoConvergence, MAX_ITERATIONS))
 }
 
-/// Largest number of Bernoulli trials of the two-vertex chains (`chain.rs`; SMS's cap: beyond it
-/// the estimate of `1/p` is truncated, a bias bounded by `(1 − p)^CAP` of that solution's
-/// contribution).
+/// Largest number of Bernoulli trials of [`bernoulli_trials`] (SMS's cap: beyond it the estimate of
+/// `1/p` is truncated, a bias bounded by `(1 − p)^CAP` of that solution's contribution).
 pub const MAX_TRIALS: u32 = 64;
 /// Largest number of Bernoulli trials in [`sample_solution`] (the one-refraction connection under
 /// a directional light, docs/manifold.md §8.1): a solution of probability `p` keeps the share

@@ -74,6 +74,13 @@ impl<'a> ManifoldStage<'a> {
         self.tracker.sample(cx, self.snee.options, snee.chain_x_i(), v)
     }
 
+    /// After [`Self::at_scatter`] at the same vertex: the two-vertex chain (`reflection_chains`,
+    /// docs/manifold.md §9), returned apart so that the class tally counts it as internal reflection.
+    #[inline]
+    pub fn chain_at_scatter(&mut self, cx: &mut Cx, v: &Scatter) -> Spectrum {
+        super::sample_chain(cx, self.snee.options, v)
+    }
+
     /// The weight of forward NEE towards `ds` at the current surface, when it is a rough `x_k`
     /// reached right after the medium vertex `x_j` (the manifold connection shares the path);
     /// `None`: the caller's weight stands.
