@@ -23,6 +23,21 @@ use rayon::prelude::*;
 
 /// Largest mesh (triangles) that stores a shading frame per triangle (36 bytes each, 9 MB at most).
 pub const MAX_FACE_FRAMES: usize = 1 << 18;
+/// Largest mesh (triangles) that stores its triangles for area sampling (72 bytes each, 1.2 MB at
+/// most): area lights are rectangles, cubes and small meshes; larger ones read the vertex arrays.
+pub const MAX_SAMPLE_TRIANGLES: usize = 1 << 14;
+
+/// What sampling a point on one triangle reads, in one place: a corner, the two edges leaving it,
+/// the normal (flipped with `flip_normals`) and the corners' uvs (`(0,0) (1,0) (0,1)` without uvs,
+/// so that uv = (b1, b2)).
+#[derive(Clone, Copy, Debug)]
+struct SampleTriangle {
+    p0: Vec3,
+    e0: Vec3,
+    e1: Vec3,
+    n: Vec3,
+    uv: [Vec2; 3],
+}
 
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -43,6 +58,8 @@ pub struct Mesh {
     /// `cube` and flat-shaded files) and the mesh has at most [`MAX_FACE_FRAMES`] triangles;
     /// empty otherwise (then it is computed per hit).
     face_frames: Vec<Frame>,
+    /// Per triangle, what area sampling reads (meshes up to [`MAX_SAMPLE_TRIANGLES`]; else empty).
+    sample_triangles: Vec<SampleTriangle>,
     /// Triangles by area (alias table, for area sampling).
     area_distr: Distribution1D,
 }
@@ -94,9 +111,13 @@ impl Mesh {
             face_normals: face_n,
             face_dp_du,
             face_frames: Vec::new(),
+            sample_triangles: Vec::new(),
             area_distr,
         };
         mesh.face_frames = mesh.flat_frames();
+        if mesh.indices.len() <= MAX_SAMPLE_TRIANGLES {
+            mesh.sample_triangles = (0..mesh.indices.len() as u32).map(|prim| mesh.sample_triangle(prim)).collect();
+        }
         mesh
     }
 
@@ -187,24 +208,15 @@ impl Mesh {
         b
     }
 
-    /// Position, geometric normal (flipped with `flip_normals`) and uv of the point at
-    /// barycentrics (b1, b2) of triangle `prim`.
+    /// The corner, edges, normal and corner uvs of triangle `prim` (see [`SampleTriangle`]).
     #[inline(always)]
-    fn point(&self, prim: u32, b1: f32, b2: f32) -> (Vec3, Vec3, Vec2) {
+    fn sample_triangle(&self, prim: u32) -> SampleTriangle {
         let idx = self.indices[prim as usize];
         let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
-        let b0 = 1.0 - b1 - b2;
-        let p = p0 * b0 + p1 * b1 + p2 * b2;
         let n = self.face_normals[prim as usize];
-        let uv = if self.uvs.is_empty() {
-            Vec2::new(b1, b2)
-        } else {
-            let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
-            u0 * b0 + u1 * b1 + u2 * b2
-        };
-        (p, if self.flip_normals { -n } else { n }, uv)
+        let uv = if self.uvs.is_empty() { [Vec2::ZERO, Vec2::X, Vec2::Y] } else { idx.map(|i| self.uvs[i as usize]) };
+        SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: if self.flip_normals { -n } else { n }, uv }
     }
-
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
         let idx = self.indices[prim as usize];
@@ -229,14 +241,21 @@ impl Mesh {
         SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray_d), shape: 0, prim }
     }
 
-    /// Uniform by area: pick a triangle by area, then a uniform point on it.
+    /// Uniform by area: pick a triangle by area, then a uniform point on it, `p0 + e0 b1 + e1 b2`
+    /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges).
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
         let total = self.surface_area();
         // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf, as before).
         let (prim, sx, _) = self.area_distr.sample(sample.x).unwrap_or((0, 0.5, 0.0));
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
-        let (p, n, uv) = self.point(prim as u32, b.x, b.y);
-        PositionSample { p, n, uv, pdf: 1.0 / total }
+        let tri = match self.sample_triangles.get(prim) {
+            Some(tri) => *tri,
+            None => self.sample_triangle(prim as u32),
+        };
+        let p = tri.p0 + tri.e0 * b.x + tri.e1 * b.y;
+        // (0,0) (1,0) (0,1) without uvs: exactly (b1, b2).
+        let uv = tri.uv[0] * (1.0 - b.x - b.y) + tri.uv[1] * b.x + tri.uv[2] * b.y;
+        PositionSample { p, n: tri.n, uv, pdf: 1.0 / total }
     }
 }
 
