@@ -86,12 +86,16 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
         let em_sample = sampler.next_2d();
         if bsdf_flags & flags::SMOOTH != 0 && !scene.emitters.is_empty() {
             stats.rays += 1;
-            let (ds, em_weight) = scene.sample_emitter_direction(si.p, Some(si.n), em_sample, true);
+            let (ds, em_weight) = scene.sample_emitter_direction(si.p, Some(si.n), em_sample, false);
             if ds.pdf > 0.0 && em_weight != Spectrum::ZERO {
                 let wo = si.to_local(ds.d);
                 let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &si, wo);
-                let mis = if ds.delta { 1.0 } else { mis_weight(ds.pdf, bsdf_pdf) };
-                result += beta * em_weight * bsdf_val * mis;
+                // A zero BSDF value (e.g. the light below a diffuse surface) adds nothing whether
+                // or not the light is visible: the shadow ray is traced for non-zero values only.
+                if bsdf_val != Spectrum::ZERO && scene.emitter_visible(si.p, Some(si.n), &ds) {
+                    let mis = if ds.delta { 1.0 } else { mis_weight(ds.pdf, bsdf_pdf) };
+                    result += beta * em_weight * bsdf_val * mis;
+                }
             }
         }
 

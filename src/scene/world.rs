@@ -102,18 +102,23 @@ impl Scene {
         if ds.pdf <= 0.0 || !crate::color::is_finite(weight) {
             return (ds, Spectrum::ZERO);
         }
-        if test_visibility {
-            let o = match ref_n {
-                Some(nrm) => crate::interaction::offset_origin(ref_p, nrm, ds.d),
-                None => ref_p,
-            };
-            let ray =
-                if ds.dist.is_finite() { crate::interaction::spawn_ray_between(o, ds.p) } else { Ray::new(o, ds.d) };
-            if self.ray_test(&ray) {
-                return (ds, Spectrum::ZERO);
-            }
+        if test_visibility && !self.emitter_visible(ref_p, ref_n, &ds) {
+            return (ds, Spectrum::ZERO);
         }
         (ds, weight)
+    }
+
+    /// True when nothing blocks the segment from `ref_p` to the emitter point of `ds` (for an
+    /// infinitely distant emitter: the ray along `ds.d`). With a surface normal `ref_n`, the
+    /// origin is offset off the surface to the side of `ds.d`.
+    #[inline]
+    pub fn emitter_visible(&self, ref_p: Vec3, ref_n: Option<Vec3>, ds: &DirectionSample) -> bool {
+        let o = match ref_n {
+            Some(nrm) => crate::interaction::offset_origin(ref_p, nrm, ds.d),
+            None => ref_p,
+        };
+        let ray = if ds.dist.is_finite() { crate::interaction::spawn_ray_between(o, ds.p) } else { Ray::new(o, ds.d) };
+        !self.ray_test(&ray)
     }
 
     fn sample_one_emitter(&self, index: usize, ref_p: Vec3, sample: Vec2) -> (DirectionSample, Spectrum) {

@@ -308,20 +308,44 @@ fn add4(px: &mut [f32], v: glam::Vec4, weight: f32) {
 }
 
 /// [`accumulate`] for RGB (the common film): a pixel's three values and its weight are four
-/// adjacent floats, updated by one 4-lane multiply-add with `(r, g, b, 1)`.
+/// adjacent floats, updated by one 4-lane multiply-add with `(r, g, b, 1)`. Footprints 3–5 pixels
+/// wide (the Gaussian's) take an unrolled row loop with one bounds check per row.
 #[inline]
 fn accumulate3(data: &mut [f32], row_stride: usize, values: &[f32], wxs: &[f32], wys: &[f32]) {
     let Ok(&[r, g, b]) = <&[f32; 3]>::try_from(values) else { return };
     let v = glam::Vec4::new(r, g, b, 1.0);
-    let n = wxs.len();
+    match wxs.len() {
+        3 => accumulate_rows::<3>(data, row_stride, v, wxs, wys),
+        4 => accumulate_rows::<4>(data, row_stride, v, wxs, wys),
+        5 => accumulate_rows::<5>(data, row_stride, v, wxs, wys),
+        n => {
+            for (j, &wy) in wys.iter().enumerate() {
+                if wy == 0.0 {
+                    continue;
+                }
+                let start = j * row_stride;
+                let row = &mut data[start..start + n * 4];
+                for (px, &wx) in row.chunks_exact_mut(4).zip(wxs) {
+                    add4(px, v, wx * wy);
+                }
+            }
+        }
+    }
+}
+
+/// The rows of [`accumulate3`] for a footprint `N` pixels wide (`wxs.len() == N`): the same
+/// products and sums in the same order, unrolled.
+#[inline(always)]
+fn accumulate_rows<const N: usize>(data: &mut [f32], row_stride: usize, v: glam::Vec4, wxs: &[f32], wys: &[f32]) {
+    let Ok(wxs) = <&[f32; N]>::try_from(wxs) else { return };
     for (j, &wy) in wys.iter().enumerate() {
         if wy == 0.0 {
             continue;
         }
         let start = j * row_stride;
-        let row = &mut data[start..start + n * 4];
-        for (px, &wx) in row.chunks_exact_mut(4).zip(wxs) {
-            add4(px, v, wx * wy);
+        let row: &mut [f32] = &mut data[start..start + 4 * N];
+        for (k, &wx) in wxs.iter().enumerate() {
+            add4(&mut row[4 * k..4 * k + 4], v, wx * wy);
         }
     }
 }

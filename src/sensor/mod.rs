@@ -59,6 +59,7 @@ pub struct Sensor {
 
 /// The camera models (closed set).
 #[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)] // one camera per scene, never per sample: no need to box
 pub enum Camera {
     Perspective(Perspective),
     IrradianceMeter(irradiance_meter::IrradianceMeter),

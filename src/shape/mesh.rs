@@ -21,6 +21,24 @@ use crate::scene::resolver::FileResolver;
 use crate::scene::{Error, Result};
 use rayon::prelude::*;
 
+/// Largest mesh (triangles) that stores a shading frame per triangle (36 bytes each, 9 MB at most).
+pub const MAX_FACE_FRAMES: usize = 1 << 18;
+/// Largest mesh (triangles) that stores its triangles for area sampling (72 bytes each, 1.2 MB at
+/// most): area lights are rectangles, cubes and small meshes; larger ones read the vertex arrays.
+pub const MAX_SAMPLE_TRIANGLES: usize = 1 << 14;
+
+/// What sampling a point on one triangle reads, in one place: a corner, the two edges leaving it,
+/// the normal (flipped with `flip_normals`) and the corners' uvs (`(0,0) (1,0) (0,1)` without uvs,
+/// so that uv = (b1, b2)).
+#[derive(Clone, Copy, Debug)]
+struct SampleTriangle {
+    p0: Vec3,
+    e0: Vec3,
+    e1: Vec3,
+    n: Vec3,
+    uv: [Vec2; 3],
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     pub positions: Vec<Vec3>,
@@ -35,6 +53,13 @@ pub struct Mesh {
     /// dp/du of each triangle's uv parametrisation (zero where the uv triangle is degenerate);
     /// empty when the mesh has no uvs (then dp/du = p1 − p0 of the barycentric uv).
     pub face_dp_du: Vec<Vec3>,
+    /// The shading frame of each triangle when it is the same at every point of every triangle
+    /// (no vertex normals, or the three vertex normals of each triangle equal, as on `rectangle`,
+    /// `cube` and flat-shaded files) and the mesh has at most [`MAX_FACE_FRAMES`] triangles;
+    /// empty otherwise (then it is computed per hit).
+    face_frames: Vec<Frame>,
+    /// Per triangle, what area sampling reads (meshes up to [`MAX_SAMPLE_TRIANGLES`]; else empty).
+    sample_triangles: Vec<SampleTriangle>,
     /// Triangles by area (alias table, for area sampling).
     area_distr: Distribution1D,
 }
@@ -77,7 +102,7 @@ impl Mesh {
             }
         };
         let (normals, area_distr) = rayon::join(vertex_normals, || Distribution1D::new(&areas));
-        Mesh {
+        let mut mesh = Mesh {
             positions,
             normals,
             uvs: data.uvs,
@@ -85,8 +110,81 @@ impl Mesh {
             flip_normals,
             face_normals: face_n,
             face_dp_du,
+            face_frames: Vec::new(),
+            sample_triangles: Vec::new(),
             area_distr,
+        };
+        mesh.face_frames = mesh.flat_frames();
+        if mesh.indices.len() <= MAX_SAMPLE_TRIANGLES {
+            mesh.sample_triangles = (0..mesh.indices.len() as u32).map(|prim| mesh.sample_triangle(prim)).collect();
         }
+        mesh
+    }
+
+    /// The geometric normal (flipped with `flip_normals`) and dp/du of triangle `prim`: both
+    /// constant over the triangle.
+    #[inline(always)]
+    fn normal_and_dp_du(&self, prim: u32) -> (Vec3, Vec3) {
+        let face_n = self.face_normals[prim as usize];
+        let n = if self.flip_normals { -face_n } else { face_n };
+        let dp_du = if self.uvs.is_empty() {
+            // uv = (b1, b2): dp/du = p1 − p0.
+            let idx = self.indices[prim as usize];
+            self.positions[idx[1] as usize] - self.positions[idx[0] as usize]
+        } else {
+            let dp_du = self.face_dp_du[prim as usize];
+            // A degenerate uv triangle: coordinate_system(face normal before flipping).
+            if dp_du == Vec3::ZERO {
+                Frame::from_normal(face_n).s
+            } else {
+                dp_du
+            }
+        };
+        (n, dp_du)
+    }
+
+    /// The shading normal at barycentrics (b0, b1, b2) of triangle `prim`: the interpolated vertex
+    /// normal (flipped with `flip_normals`), or the geometric normal `n` without vertex normals or
+    /// where the interpolation vanishes.
+    #[inline(always)]
+    fn shading_normal(&self, prim: u32, n: Vec3, b0: f32, b1: f32, b2: f32) -> Vec3 {
+        if self.normals.is_empty() {
+            return n;
+        }
+        let [n0, n1, n2] = self.indices[prim as usize].map(|i| self.normals[i as usize]);
+        let sh_n = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
+        if sh_n == Vec3::ZERO {
+            n
+        } else if self.flip_normals {
+            -sh_n
+        } else {
+            sh_n
+        }
+    }
+
+    /// Per-triangle shading frames when every triangle's shading normal is constant (see
+    /// `face_frames`), else empty. With equal vertex normals the frame is built from the vertex
+    /// normal itself: the interpolation `normalize(b0 n + b1 n + b2 n)` is the same vector up to
+    /// rounding.
+    fn flat_frames(&self) -> Vec<Frame> {
+        if self.indices.len() > MAX_FACE_FRAMES {
+            return Vec::new();
+        }
+        let flat = self.normals.is_empty()
+            || self.indices.par_iter().all(|idx| {
+                let [n0, n1, n2] = idx.map(|i| self.normals[i as usize]);
+                n0 == n1 && n1 == n2
+            });
+        if !flat {
+            return Vec::new();
+        }
+        (0..self.indices.len() as u32)
+            .into_par_iter()
+            .map(|prim| {
+                let (n, dp_du) = self.normal_and_dp_du(prim);
+                shading_frame(self.shading_normal(prim, n, 1.0, 0.0, 0.0), dp_du)
+            })
+            .collect()
     }
 
     pub fn surface_area(&self) -> f32 {
@@ -110,67 +208,54 @@ impl Mesh {
         b
     }
 
-    /// Position, geometric normal (flipped with `flip_normals`) and uv of the point at
-    /// barycentrics (b1, b2) of triangle `prim`.
+    /// The corner, edges, normal and corner uvs of triangle `prim` (see [`SampleTriangle`]).
     #[inline(always)]
-    fn point(&self, prim: u32, b1: f32, b2: f32) -> (Vec3, Vec3, Vec2) {
+    fn sample_triangle(&self, prim: u32) -> SampleTriangle {
         let idx = self.indices[prim as usize];
         let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
-        let b0 = 1.0 - b1 - b2;
-        let p = p0 * b0 + p1 * b1 + p2 * b2;
         let n = self.face_normals[prim as usize];
-        let uv = if self.uvs.is_empty() {
-            Vec2::new(b1, b2)
-        } else {
-            let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
-            u0 * b0 + u1 * b1 + u2 * b2
-        };
-        (p, if self.flip_normals { -n } else { n }, uv)
+        let uv = if self.uvs.is_empty() { [Vec2::ZERO, Vec2::X, Vec2::Y] } else { idx.map(|i| self.uvs[i as usize]) };
+        SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: if self.flip_normals { -n } else { n }, uv }
     }
-
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
         let idx = self.indices[prim as usize];
         let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
         let b0 = 1.0 - b1 - b2;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let face_n = self.face_normals[prim as usize];
-        let n = if self.flip_normals { -face_n } else { face_n };
-        let (uv, dp_du) = if self.uvs.is_empty() {
-            // uv = (b1, b2): dp/du = p1 − p0.
-            (Vec2::new(b1, b2), p1 - p0)
+        let uv = if self.uvs.is_empty() {
+            Vec2::new(b1, b2)
         } else {
             let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
-            let dp_du = self.face_dp_du[prim as usize];
-            // A degenerate uv triangle: coordinate_system(face normal before flipping).
-            let dp_du = if dp_du == Vec3::ZERO { Frame::from_normal(face_n).s } else { dp_du };
-            (u0 * b0 + u1 * b1 + u2 * b2, dp_du)
+            u0 * b0 + u1 * b1 + u2 * b2
         };
-        let sh_n = if self.normals.is_empty() {
-            n
-        } else {
-            let [n0, n1, n2] = idx.map(|i| self.normals[i as usize]);
-            let sh_n = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
-            if sh_n == Vec3::ZERO {
-                n
-            } else if self.flip_normals {
-                -sh_n
-            } else {
-                sh_n
+        let face_n = self.face_normals[prim as usize];
+        let n = if self.flip_normals { -face_n } else { face_n };
+        let sh_frame = match self.face_frames.get(prim as usize) {
+            Some(frame) => *frame,
+            None => {
+                let (n, dp_du) = self.normal_and_dp_du(prim);
+                shading_frame(self.shading_normal(prim, n, b0, b1, b2), dp_du)
             }
         };
-        let sh_frame = shading_frame(sh_n, dp_du);
         SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray_d), shape: 0, prim }
     }
 
-    /// Uniform by area: pick a triangle by area, then a uniform point on it.
+    /// Uniform by area: pick a triangle by area, then a uniform point on it, `p0 + e0 b1 + e1 b2`
+    /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges).
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
         let total = self.surface_area();
         // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf, as before).
         let (prim, sx, _) = self.area_distr.sample(sample.x).unwrap_or((0, 0.5, 0.0));
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
-        let (p, n, uv) = self.point(prim as u32, b.x, b.y);
-        PositionSample { p, n, uv, pdf: 1.0 / total }
+        let tri = match self.sample_triangles.get(prim) {
+            Some(tri) => *tri,
+            None => self.sample_triangle(prim as u32),
+        };
+        let p = tri.p0 + tri.e0 * b.x + tri.e1 * b.y;
+        // (0,0) (1,0) (0,1) without uvs: exactly (b1, b2).
+        let uv = tri.uv[0] * (1.0 - b.x - b.y) + tri.uv[1] * b.x + tri.uv[2] * b.y;
+        PositionSample { p, n: tri.n, uv, pdf: 1.0 / total }
     }
 }
 

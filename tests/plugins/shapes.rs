@@ -63,6 +63,27 @@ fn rectangle_area_sampling() {
     check("rectangle", shape(Geometry::Mesh(Mesh::new(rectangle_data(), &m, false, false))), Vec3::ZERO);
 }
 
+/// Triangles of unequal areas (alias-table selection, per-triangle sampling data, uvs present):
+/// a planar fan at z = 1, so that every ray from the origin meets it at most once.
+#[test]
+fn mesh_of_unequal_triangles_area_sampling() {
+    use snee::math::Vec2;
+    use snee::shape::mesh_data::MeshData;
+    let positions = vec![
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(1.2, -0.1, 1.0),
+        Vec3::new(0.9, 0.6, 1.0),
+        Vec3::new(-0.2, 0.8, 1.0),
+        Vec3::new(-0.9, 0.1, 1.0),
+        Vec3::new(-0.3, -0.9, 1.0),
+    ];
+    let uvs = positions.iter().map(|p| Vec2::new(p.x, p.y)).collect();
+    let indices = vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5], [0, 5, 1]];
+    let data = MeshData { positions, normals: Vec::new(), uvs, indices };
+    let m = Mat4::from_translation(Vec3::new(0.1, 0.0, 0.3)) * Mat4::from_rotation_y(0.3);
+    check("mesh fan", shape(Geometry::Mesh(Mesh::new(data, &m, false, true))), Vec3::ZERO);
+}
+
 #[test]
 fn disk_area_sampling() {
     let m = Mat4::from_translation(Vec3::new(-0.3, 0.4, 1.0))
