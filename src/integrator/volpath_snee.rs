@@ -70,7 +70,13 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
         }
     };
     let chains = props.bool("reflection_chains", false)?;
-    Ok(SneeOptions { technique, transport, rate, chains })
+    let connection_rate = props.float_opt("connection_rate")?;
+    if let Some(q) = connection_rate {
+        if !(q > 0.0 && q <= 1.0) {
+            return Err(props.error("connection_rate", "volpath_snee: connection_rate must be in (0, 1]"));
+        }
+    }
+    Ok(SneeOptions { technique, transport, rate, chains, connection_rate })
 }
 
 /// The `connection` parameter (manifold NEE, `integrator/manifold/`).
@@ -91,6 +97,7 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         snee.flat = manifold::flat::flat_boundaries(scene);
         snee.rough = manifold::rough::rough_boundaries(scene);
         snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
+        snee::rate::complete_rates(scene, &mut snee);
     }
     snee
 }

@@ -21,7 +21,9 @@ use common::{render_batches, scene, welch_compare, GLASS, MATCHED};
 const SPHERE: &str = r#"<shape type="sphere"><point name="center" x="-2" y="1" z="3"/><float name="radius" value="0.5"/>
         <emitter type="area"><rgb name="radiance" value="20, 20, 20"/></emitter></shape>"#;
 
-const COMPLETE: &str = r#"<string name="connection" value="complete"/>"#;
+// SNEE's rate given: by default SNEE does not run here (docs/snee.md §5), and this test checks
+// the three-way MIS with SNEE; `COMPLETE_FORWARD` covers the default (no SNEE).
+const COMPLETE: &str = r#"<string name="connection" value="complete"/><float name="snee_rate" value="0.25"/>"#;
 const COMPLETE_FORWARD: &str = r#"<string name="connection" value="complete"/><string name="snee" value="forward"/>"#;
 
 /// `medium_cube` with the cube replaced by a PLY mesh of `scenes/meshes`, emitters hidden.
