@@ -133,3 +133,30 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
     assert!(checked > 50 && shared > 5, "too few suffixes checked ({checked}, {shared} shared)");
     assert!(worst < 1e-6 && worst_grazing < 1e-6, "weights sum to 1 ± {worst} (grazing ± {worst_grazing})");
 }
+
+/// SNEE's default rate under `connection = complete` (docs/snee.md §5, `snee::rate::complete_rates`):
+/// 0 in the glass pebble lit by the sphere light only (the curved area-light connection serves it),
+/// and under an environment 0 when the medium is optically thin, the shared rate when thick; the
+/// paper's estimator, a given `snee_rate` and a delta light keep their rates.
+#[test]
+fn default_snee_rate_under_complete() {
+    let rate = |xml: &str| {
+        let s = scene(xml, &[]);
+        snee::integrator::manifold::tables(&s).expect("volpath_snee").rates[0]
+    };
+    let complete = r#"<string name="connection" value="complete"/>"#;
+    let sphere = mesh("volpath_snee", complete, GLASS, "pebble.ply");
+    assert_eq!(rate(&sphere), Some(0.0));
+    assert_eq!(rate(&mesh("volpath_snee", "", GLASS, "pebble.ply")), Some(snee::integrator::snee::AUTO_RATE_SHARED));
+    assert_eq!(rate(&mesh("volpath_snee", COMPLETE, GLASS, "pebble.ply")), Some(0.25));
+    let env = r#"<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>"#;
+    let with_env = |sigma_t: &str| {
+        sphere
+            .replace(SPHERE, env)
+            .replace(r#"<float name="sigma_t" value="2"/>"#, &format!(r#"<float name="sigma_t" value="{sigma_t}"/>"#))
+    };
+    assert_eq!(rate(&with_env("0.1")), Some(0.0));
+    assert_eq!(rate(&with_env("1000")), Some(snee::integrator::snee::AUTO_RATE_SHARED));
+    let sun = r#"<emitter type="directional"><vector name="direction" x="0" y="0" z="-1"/></emitter>"#;
+    assert_eq!(rate(&sphere.replace(SPHERE, sun)), Some(1.0));
+}
