@@ -160,3 +160,17 @@ fn default_snee_rate_under_complete() {
     let sun = r#"<emitter type="directional"><vector name="direction" x="0" y="0" z="-1"/></emitter>"#;
     assert_eq!(rate(&sphere.replace(SPHERE, sun)), Some(1.0));
 }
+
+/// `connection_rate` outside (0, 1] is an error with its position, not a panic.
+#[test]
+fn connection_rate_out_of_range_is_an_error() {
+    for q in ["0", "1.5", "-1"] {
+        let props =
+            format!(r#"<string name="connection" value="complete"/><float name="connection_rate" value="{q}"/>"#);
+        let text = mesh("volpath_snee", &props, GLASS, "pebble.ply");
+        let parsed = snee::scene::xml::parse_str(&text, "q.xml", &common::root().join("scenes"), &[]).unwrap();
+        let err = snee::scene::build::build_scene(&parsed).err().expect("connection_rate must be rejected");
+        let s = err.to_string();
+        assert!(s.starts_with("q.xml:") && s.contains("connection_rate must be in (0, 1]"), "{}", s);
+    }
+}
