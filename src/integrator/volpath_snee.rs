@@ -9,7 +9,8 @@
 //! | `transport`  | string  | `all` (default); `snee`: only paths whose last two scattering vertices before leaving through the boundary are medium vertices, in SNEE's support (the paper's Figure 3) |
 //! | `connection` | string  | `paper` (default): the paper's estimator; `complete`: also manifold NEE through flat smooth boundaries (`manifold/`, docs/manifold.md) |
 //! | `reflection_chains` | boolean | with `connection = complete`: also connect through an internal reflection then a refraction (two-vertex chains, `manifold/chain.rs`, docs/manifold.md §9) under a directional light; default `false` (its cost exceeds its gain on the paper's statue) |
-//! | `snee_rate`  | float   | probability `r` of running SNEE at a scattering vertex (default: chosen per medium from its boundary and the lights, see [`snee::auto_rate`]); MIS counts SNEE's density as `r · pdf_snee`, so any `r` is unbiased |
+//! | `snee_rate`  | float   | probability `r` of running SNEE at a scattering vertex (default: chosen per medium from its boundary and the lights, see [`snee::auto_rate`], revised under `connection = complete` by `snee::rate::complete_rates`); MIS counts SNEE's density as `r · pdf_snee`, so any `r` is unbiased |
+//! | `connection_rate` | float | with `connection = complete`: probability `q` in (0, 1] that the curved area-light connection (`manifold/curved_finite.rs`) runs at a medium vertex whose emitter sample picked an area light; default 0.05 (`curved_finite::RATE`, docs/manifold.md §8.2); part of its density, so any `q` is unbiased |
 //!
 //! ```xml
 //! <integrator type="volpath_snee">
@@ -70,7 +71,13 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
         }
     };
     let chains = props.bool("reflection_chains", false)?;
-    Ok(SneeOptions { technique, transport, rate, chains })
+    let connection_rate = props.float_opt("connection_rate")?;
+    if let Some(q) = connection_rate {
+        if !(q > 0.0 && q <= 1.0) {
+            return Err(props.error("connection_rate", "volpath_snee: connection_rate must be in (0, 1]"));
+        }
+    }
+    Ok(SneeOptions { technique, transport, rate, chains, connection_rate })
 }
 
 /// The `connection` parameter (manifold NEE, `integrator/manifold/`).
@@ -91,6 +98,7 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         snee.flat = manifold::flat::flat_boundaries(scene);
         snee.rough = manifold::rough::rough_boundaries(scene);
         snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
+        snee::rate::complete_rates(scene, &mut snee);
     }
     snee
 }

@@ -21,7 +21,9 @@ use common::{render_batches, scene, welch_compare, GLASS, MATCHED};
 const SPHERE: &str = r#"<shape type="sphere"><point name="center" x="-2" y="1" z="3"/><float name="radius" value="0.5"/>
         <emitter type="area"><rgb name="radiance" value="20, 20, 20"/></emitter></shape>"#;
 
-const COMPLETE: &str = r#"<string name="connection" value="complete"/>"#;
+// SNEE's rate given: by default SNEE does not run here (docs/snee.md §5), and this test checks
+// the three-way MIS with SNEE; `COMPLETE_FORWARD` covers the default (no SNEE).
+const COMPLETE: &str = r#"<string name="connection" value="complete"/><float name="snee_rate" value="0.25"/>"#;
 const COMPLETE_FORWARD: &str = r#"<string name="connection" value="complete"/><string name="snee" value="forward"/>"#;
 
 /// `medium_cube` with the cube replaced by a PLY mesh of `scenes/meshes`, emitters hidden.
@@ -130,4 +132,45 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
     eprintln!("{checked} suffixes ({hidden} with x_k hidden from x_i skipped), {shared} shared (no weight above 0.99); worst |Σw − 1| = {worst:.2e} (cos θ_y > 0.1), {worst_grazing:.2e} (grazing)");
     assert!(checked > 50 && shared > 5, "too few suffixes checked ({checked}, {shared} shared)");
     assert!(worst < 1e-6 && worst_grazing < 1e-6, "weights sum to 1 ± {worst} (grazing ± {worst_grazing})");
+}
+
+/// SNEE's default rate under `connection = complete` (docs/snee.md §5, `snee::rate::complete_rates`):
+/// 0 in the glass pebble lit by the sphere light only (the curved area-light connection serves it),
+/// and under an environment 0 when the medium is optically thin, the shared rate when thick; the
+/// paper's estimator, a given `snee_rate` and a delta light keep their rates.
+#[test]
+fn default_snee_rate_under_complete() {
+    let rate = |xml: &str| {
+        let s = scene(xml, &[]);
+        snee::integrator::manifold::tables(&s).expect("volpath_snee").rates[0]
+    };
+    let complete = r#"<string name="connection" value="complete"/>"#;
+    let sphere = mesh("volpath_snee", complete, GLASS, "pebble.ply");
+    assert_eq!(rate(&sphere), Some(0.0));
+    assert_eq!(rate(&mesh("volpath_snee", "", GLASS, "pebble.ply")), Some(snee::integrator::snee::AUTO_RATE_SHARED));
+    assert_eq!(rate(&mesh("volpath_snee", COMPLETE, GLASS, "pebble.ply")), Some(0.25));
+    let env = r#"<emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>"#;
+    let with_env = |sigma_t: &str| {
+        sphere
+            .replace(SPHERE, env)
+            .replace(r#"<float name="sigma_t" value="2"/>"#, &format!(r#"<float name="sigma_t" value="{sigma_t}"/>"#))
+    };
+    assert_eq!(rate(&with_env("0.1")), Some(0.0));
+    assert_eq!(rate(&with_env("1000")), Some(snee::integrator::snee::AUTO_RATE_SHARED));
+    let sun = r#"<emitter type="directional"><vector name="direction" x="0" y="0" z="-1"/></emitter>"#;
+    assert_eq!(rate(&sphere.replace(SPHERE, sun)), Some(1.0));
+}
+
+/// `connection_rate` outside (0, 1] is an error with its position, not a panic.
+#[test]
+fn connection_rate_out_of_range_is_an_error() {
+    for q in ["0", "1.5", "-1"] {
+        let props =
+            format!(r#"<string name="connection" value="complete"/><float name="connection_rate" value="{q}"/>"#);
+        let text = mesh("volpath_snee", &props, GLASS, "pebble.ply");
+        let parsed = snee::scene::xml::parse_str(&text, "q.xml", &common::root().join("scenes"), &[]).unwrap();
+        let err = snee::scene::build::build_scene(&parsed).err().expect("connection_rate must be rejected");
+        let s = err.to_string();
+        assert!(s.starts_with("q.xml:") && s.contains("connection_rate must be in (0, 1]"), "{}", s);
+    }
 }

@@ -185,7 +185,7 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     match super::finite::pick(scene, u) {
         super::finite::Pick::Distant => {}
         super::finite::Pick::Finite(lp) if lp.area.is_some() => {
-            if (sampler.next_1d() as f64) >= super::curved_finite::RATE {
+            if (sampler.next_1d() as f64) >= super::curved_finite::rate(opts) {
                 return Some(Spectrum::ZERO);
             }
             return Some(super::curved_finite::sample(scene, opts, x_i, &x_j, &lp, v.beta, channel, stats));

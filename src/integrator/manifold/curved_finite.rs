@@ -40,7 +40,13 @@ use crate::shape::Geometry;
 /// Probability that the connection runs at a medium vertex whose emitter sample picked an area
 /// light (a constant, part of its density everywhere): each connection costs a Newton solve
 /// (docs/manifold.md §8.2, "Cost").
-pub const RATE: f64 = 0.1;
+pub const RATE: f64 = 0.05;
+
+/// The connection's rate `q` under `opts`: `connection_rate`, else [`RATE`].
+#[inline]
+pub fn rate(opts: SneeOptions) -> f64 {
+    opts.connection_rate.map_or(RATE, |q| q as f64)
+}
 
 /// Two directions are the same solution when they differ by less than this (radians).
 const SAME_SOLUTION: f64 = 1e-4;
@@ -161,6 +167,7 @@ fn faces(n_y: Vec3, y: Vec3, x_j: Vec3) -> bool {
 #[allow(clippy::too_many_arguments)]
 fn density(
     scene: &Scene,
+    opts: SneeOptions,
     x_j: &MediumVertex,
     omega_jk: Vec3,
     y: Vec3,
@@ -176,7 +183,7 @@ fn density(
     match resolve(scene, x_j, y, stats) {
         Some((sol, _)) if (sol.omega - omega_jk.as_dvec3()).length() < SAME_SOLUTION => {
             stats.manifold_resolve_matches += 1;
-            RATE * mis::area_density(p_y, sol.g, cos_y)
+            rate(opts) * mis::area_density(p_y, sol.g, cos_y)
         }
         _ => 0.0,
     }
@@ -195,8 +202,8 @@ pub struct PointConnection {
 }
 
 /// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`), given that it runs
-/// (probability [`RATE`], the caller's draw): solve from the deterministic seed, verify, value
-/// (divided by [`RATE`]), and MIS-weight against forward tracing and SNEE. Counts solutions and
+/// (probability [`rate`], the caller's draw): solve from the deterministic seed, verify, value
+/// (divided by [`rate`]), and MIS-weight against forward tracing and SNEE. Counts solutions and
 /// failures.
 #[allow(clippy::too_many_arguments)]
 pub fn connect(
@@ -242,9 +249,9 @@ pub fn connect(
     let d_jk = si_k.t;
     let eta = sol.patch.eta as f32;
     let f = fresnel(sol.refracted.cos_out as f32, eta).0;
-    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (RATE * lp.p_y);
+    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (rate(opts) * lp.p_y);
     let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
-    let p_man = RATE * mis::area_density(lp.p_y, sol.g, cos_y);
+    let p_man = rate(opts) * mis::area_density(lp.p_y, sol.g, cos_y);
     let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
     let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
     Some(PointConnection { value, weight, si_k, omega, light })
@@ -325,7 +332,7 @@ pub fn forward_weight(
     let n_y = light_normal(scene, y.shape, y.p, y.n);
     let cos_y = n_y.dot(omega_l).abs();
     let d_jk = (p.si_k.p - p.x_j.p).length();
-    let p_man = density(scene, &p.x_j, p.omega_jk, y.p, n_y, p_y, cos_y, stats);
+    let p_man = density(scene, opts, &p.x_j, p.omega_jk, y.p, n_y, p_y, cos_y, stats);
     let ds = scene.direction_sample_for_hit(p.si_k.p, y);
     let light = LightSample::hit(omega_l, y.p, ds.dist, scene.pdf_emitter_direction(p.si_k.p, &ds));
     let pd = pdfs(scene, opts, p.x_i.as_ref(), &p.x_j, &p.si_k, p.omega_jk, d_jk, &light, p_man, channel, true, stats);
@@ -357,7 +364,7 @@ pub fn snee_weight(
     let v_jk = s.si_k.p - s.x_j;
     let d_jk = v_jk.length();
     let omega_jk = v_jk / d_jk;
-    let p_man = density(scene, &x_j, omega_jk, light.p, n_y, p_y, cos_y, &mut no_stats);
+    let p_man = density(scene, opts, &x_j, omega_jk, light.p, n_y, p_y, cos_y, &mut no_stats);
     let p = pdfs(scene, opts, Some(&s.x_i), &x_j, &s.si_k, omega_jk, d_jk, light, p_man, channel, false, &mut no_stats);
     Some(mis::env_weight(opts, EnvTechnique::Snee, p))
 }

@@ -26,11 +26,21 @@ pub struct SneeOptions {
     /// `reflection_chains` (with `connection = complete`): also the two-vertex chains (internal
     /// reflection, then refraction) of `manifold/chain.rs` under a directional light.
     pub chains: bool,
+    /// `connection_rate` (with `connection = complete`): the probability `q` that the curved
+    /// area-light connection (`manifold/curved_finite.rs`) runs at a medium vertex whose emitter
+    /// sample picked an area light; `None`: `manifold::curved_finite::RATE`.
+    pub connection_rate: Option<f32>,
 }
 
 impl Default for SneeOptions {
     fn default() -> Self {
-        SneeOptions { technique: SneeTechnique::Mis, transport: SneeTransport::All, rate: None, chains: false }
+        SneeOptions {
+            technique: SneeTechnique::Mis,
+            transport: SneeTransport::All,
+            rate: None,
+            chains: false,
+            connection_rate: None,
+        }
     }
 }
 

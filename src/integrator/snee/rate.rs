@@ -65,6 +65,74 @@ pub fn auto_rate(scene: &Scene, boundaries: &[Boundary]) -> f32 {
     }
 }
 
+/// SNEE rate under `connection = complete` in a medium whose curved smooth boundary the
+/// area-light connection (`manifold/curved_finite.rs`) serves, in a scene lit by area lights only
+/// (docs/snee.md §5): 0, SNEE does not run there. The connection and forward tracing make every
+/// suffix SNEE would make, and SNEE's MIS weight re-solves the connection's Newton problem for
+/// each of its samples. Measured on `sphere_smooth_st34` / `st02` (docs/snee.md §5): r = 0 with
+/// `q = 0.05` 1.48× / 0.90× `volpath` (median of per-seed ratios, absolute variance) against
+/// 1.25× / 0.72× for r = 0.25 with `q = 0.1`.
+pub const AUTO_RATE_COMPLETE_AREA: f32 = 0.0;
+
+/// Optical size below which SNEE does not run under `connection = complete` in a medium behind a
+/// smooth boundary under non-delta lights (docs/snee.md §5): there few paths reach the boundary
+/// after two medium vertices and SNEE's samples cost more than they bring.
+pub const THIN_OPTICAL_SIZE: f32 = 4.0;
+
+/// The optical size of `medium`: its smallest extinction coefficient (over channels) times the
+/// shortest side of the bounding box of the shapes that enclose it.
+pub fn optical_size(scene: &Scene, medium: u32) -> f32 {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for s in scene.shapes.iter().filter(|s| s.interior == Some(medium) && s.exterior.is_none()) {
+        let b = s.bounds();
+        lo = lo.min(b.min);
+        hi = hi.max(b.max);
+    }
+    let side = (hi - lo).min_element().max(0.0);
+    scene.media[medium as usize].sigma_t.min_element() * side
+}
+
+/// With `connection = complete` and no `snee_rate` given: the default rates of [`auto_rate`]
+/// revised once the manifold tables in `snee` are built (docs/snee.md §5), from the scene's light
+/// types, the medium's boundary kind and its optical size only. SNEE does not run (`r = 0`) in a
+/// medium with a CURVED smooth boundary (not one of the flat boundaries of `snee.flat`) when the
+/// scene has no delta emitter and either
+/// - the curved area-light connection serves the medium and every emitter is an area light
+///   ([`AUTO_RATE_COMPLETE_AREA`]), or
+/// - the medium is optically thin ([`optical_size`] below [`THIN_OPTICAL_SIZE`]).
+///
+/// Elsewhere (delta lights; rough or flat boundaries; thick media under an environment) the rates of
+/// [`auto_rate`] stand.
+pub fn complete_rates(scene: &Scene, snee: &mut Snee) {
+    if snee.options.rate.is_some() {
+        return;
+    }
+    let area_only = scene.emitters.iter().all(|e| matches!(e, SceneEmitter::Area { .. }));
+    let delta_light = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(e) if e.is_delta()));
+    for (m, rate) in snee.rates.iter_mut().enumerate() {
+        // Curved: smooth, and no flat boundary the closed-form connections serve.
+        let curved = smooth_boundary(scene, m as u32) && snee.flat.get(m).is_none_or(|f| f.is_none());
+        if rate.is_none() || delta_light || !curved {
+            continue;
+        }
+        if area_only && snee.curved.get(m).copied().unwrap_or(false) {
+            *rate = Some(AUTO_RATE_COMPLETE_AREA);
+        } else if optical_size(scene, m as u32) < THIN_OPTICAL_SIZE {
+            *rate = Some(0.0);
+        }
+    }
+}
+
+/// Is some boundary enclosing `medium` a smooth `dielectric`?
+fn smooth_boundary(scene: &Scene, medium: u32) -> bool {
+    scene
+        .shapes
+        .iter()
+        .filter(|s| s.interior == Some(medium) && s.exterior.is_none())
+        .any(|s| matches!(Boundary::of(&scene.bsdfs[s.bsdf as usize]), Some(Boundary::Smooth { .. })))
+}
+
 /// The SNEE vertex at a real scatter `p` of depth `depth`, or `None` where SNEE does not run
 /// (nor need forward suffixes be tracked: rate 0 with all transport kept).
 pub fn snee_vertex(snee: &Snee, medium: u32, p: Vec3, wi: Vec3, depth: u32, max_depth: u32) -> Option<SneeVertex> {
