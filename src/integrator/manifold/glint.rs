@@ -112,7 +112,8 @@ impl CameraMap {
     pub fn direction(&self, u: DVec2) -> DVec3 {
         let s = u / self.film_size + self.offset;
         let p = DVec3::new((1.0 - 2.0 * s.x) * self.half_extent.x, (1.0 - 2.0 * s.y) * self.half_extent.y, 1.0);
-        self.to_world.transform_vector3(p.normalize())
+        // Normalized after the rotation: the f32 camera matrix is orthonormal to ~1e-7 only.
+        self.to_world.transform_vector3(p).normalize()
     }
 
     /// The film position whose ray has direction `d` (inverse of [`CameraMap::direction`]).
@@ -212,7 +213,7 @@ impl Region {
 }
 
 /// The chain at `u` with its patches located by ray casts.
-fn locate_at(
+pub fn locate_at(
     locate: &mut impl GlintLocate,
     cam: &CameraMap,
     chain: Chain,
@@ -297,7 +298,7 @@ pub fn solve(
         let Some(j) = jacobian(cam, chain, &p1, p2.as_ref(), u, omega_l, l) else { return (None, it) };
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
         if norm < TOLERANCE {
-            if !(det.abs() > 0.0 && det.is_finite()) || !region.contains(u) {
+            if !(det.abs() > 0.0 && det.is_finite() && region.contains(u)) {
                 return (None, it);
             }
             let s = GlintSolution { chain, u, map: m, p1, p2, du_do: 1.0 / det.abs(), iterations: it };
@@ -384,9 +385,9 @@ pub fn geometric_weight(s: &GlintSolution) -> f64 {
 }
 
 /// The scene as the glint's rays see it.
-struct SceneGlint<'a> {
-    scene: &'a Scene,
-    rays: u64,
+pub struct SceneGlint<'a> {
+    pub scene: &'a Scene,
+    pub rays: u64,
 }
 
 /// The patch of a medium's smooth dielectric boundary hit from outside along `d`, and the medium.
@@ -422,7 +423,7 @@ fn agrees(si: &SurfaceInteraction, x: DVec3, n_s: DVec3, t: f64) -> bool {
 
 /// Verify a solution with the renderer's rays and return its value without `N`: the geometric
 /// weight times the medium's transmittance and the light segment's.
-fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3, stats: &mut LocalStats) -> Spectrum {
+pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3, stats: &mut LocalStats) -> Spectrum {
     let d = s.map.d.as_vec3().normalize();
     let omega_l = omega_l.as_vec3();
     stats.rays += 1;
