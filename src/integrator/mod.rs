@@ -148,7 +148,11 @@ impl Integrator {
                 volpathmis::li_tally(scene, sampler, ray, medium, stats, roulette, &mut tally)
             }
             Integrator::VolpathSnee(_, snee) => {
-                volpath::li_tally(scene, sampler, ray, medium, stats, Some(snee), &mut tally)
+                let (l, valid) = volpath::li_tally(scene, sampler, ray, medium, stats, Some(snee), &mut tally);
+                // Glints (`manifold/glint.rs`): class `surface`.
+                let glint = manifold::glint::sample(scene, snee, sampler, &ray, stats);
+                tally.values[PathClass::Surface as usize] += glint;
+                (l + glint, valid)
             }
         };
         (l, valid, tally.values)

@@ -79,4 +79,10 @@ counters! {
     /// for a suffix forward tracing or SNEE made (`curved_finite.rs`), and those that found it.
     manifold_resolves,
     manifold_resolve_matches,
+    /// Glint solves from the camera (`manifold/glint.rs`, one per seed), their Newton iterations,
+    /// the glints found and verified, and the Bernoulli trials stopped at `glint::MAX_TRIALS`.
+    glint_solves,
+    glint_iterations,
+    glint_solutions,
+    glint_trials_capped,
 }

@@ -40,7 +40,9 @@ pub fn li(
     medium: Option<u32>,
     stats: &mut LocalStats,
 ) -> (Spectrum, bool) {
-    volpath::li_with(scene, sampler, ray, medium, stats, Some(snee))
+    let (l, valid) = volpath::li_with(scene, sampler, ray, medium, stats, Some(snee));
+    // Glints from the camera (`connection = complete`, docs/manifold.md §10); zero, drawing nothing, elsewhere.
+    (l + manifold::glint::sample(scene, snee, sampler, &ray, stats), valid)
 }
 
 /// The `snee`, `snee_rate` and `transport` parameters.

@@ -38,6 +38,7 @@ pub mod curved;
 pub mod curved_finite;
 pub mod finite;
 pub mod flat;
+pub mod glint;
 pub mod locate;
 pub mod mis;
 pub mod newton;
