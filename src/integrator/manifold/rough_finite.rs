@@ -192,7 +192,7 @@ pub fn point_reference(
                     _ => break,
                 }
             }
-            let reference = Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf };
+            let reference = Reference::of_point(scene, &si);
             Some((reference, towards(si.p)))
         }
     }
@@ -229,7 +229,7 @@ pub fn density(
         return 0.0;
     }
     let Some((r, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else { return 0.0 };
-    let p_imp = rough_lobe::pdf_inner_in(&scene.bsdfs[r.bsdf as usize], r.frame, omega_ref, omega_jk);
+    let p_imp = rough_lobe::pdf_inner_ref(scene, &r, omega_ref, omega_jk);
     combine(p_y, p_imp, si_k, end)
 }
 
@@ -306,8 +306,7 @@ pub fn connect(
     let Some((reference, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else {
         return fail(stats);
     };
-    let bsdf_ref = &scene.bsdfs[reference.bsdf as usize];
-    let omega_jk = rough_lobe::sample_inner_in(bsdf_ref, reference.frame, omega_ref, u1, u2)?;
+    let omega_jk = rough_lobe::sample_inner_ref(scene, &reference, omega_ref, u1, u2)?;
     let Some(si_k) = rough_lobe::trace_inner(scene, x_j, plane, omega_jk, stats) else {
         return fail(stats);
     };
@@ -321,7 +320,7 @@ pub fn connect(
     if tr == Spectrum::ZERO || le == Spectrum::ZERO {
         return fail(stats);
     }
-    let p_imp = rough_lobe::pdf_inner_in(bsdf_ref, reference.frame, omega_ref, omega_jk);
+    let p_imp = rough_lobe::pdf_inner_ref(scene, &reference, omega_ref, omega_jk);
     let p_man = combine(p_y, p_imp, &si_k, &end);
     if !(p_man > 0.0) {
         return fail(stats);
