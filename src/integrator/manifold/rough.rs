@@ -9,7 +9,9 @@
 //! each plane orientation's (one sample per orientation; `x_k` must lie on that plane); on a
 //! CURVED one (interpolated normals, spheres) it is the shading frame where the straight line from
 //! `x_j` towards the light meets the boundary ([`curved_reference`], one ray), a deterministic
-//! function of `(x_j, omega_l)`, so the density stays evaluable for any path. Conditioned on `x_j`,
+//! function of `(x_j, omega_l)`, so the density stays evaluable for any path; there half the
+//! samples come from a wider lobe (`rough_lobe::sample_inner_ref`, docs/manifold.md §7.1
+//! "Defensive lobe"), and `p_imp` below is that mixture's density. Conditioned on `x_j`,
 //! the density of `omega_jk` (solid angle at `x_j`) is
 //!
 //! ```text

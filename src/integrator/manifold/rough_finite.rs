@@ -7,9 +7,11 @@
 //! otherwise, front side only), then a reference ([`point_reference`]: a shading frame and the
 //! direction `omega_ref` from the refined boundary point towards `y`, a deterministic function
 //! of `(x_j, y)`), then the inner direction `omega_in ~ bsdf.sample(wi = omega_ref)` in
-//! importance mode in that frame, `omega_jk = −omega_in`, and traces `x_j → x_k`. The value uses
-//! the TRUE BSDF at `x_k` (its own shading frame) and the real emitter direction
-//! `omega_l = (y − x_k)/|y − x_k|`, with the light segment `x_k → y` through passable surfaces.
+//! importance mode in that frame (on a curved boundary mixed with a wider lobe,
+//! `rough_lobe::sample_inner_ref`, whose density `p_imp` below then is), `omega_jk = −omega_in`,
+//! and traces `x_j → x_k`. The value uses the TRUE BSDF at `x_k` (its own shading frame) and the
+//! real emitter direction `omega_l = (y − x_k)/|y − x_k|`, with the light segment `x_k → y`
+//! through passable surfaces.
 //!
 //! Density, in the measure of the other techniques (`rough_lobe::rough_pdfs`: solid angle of `omega_jk`
 //! at `x_j` times solid angle of `omega_l` at `x_k`), conditioned on `x_j`:

@@ -159,18 +159,19 @@ pub const WIDE_MAX_ALPHA: f32 = 0.5;
 pub fn widened(bsdf: &Bsdf) -> Option<Bsdf> {
     let Bsdf::RoughDielectric(r) = bsdf else { return None };
     let a = (r.alpha_u * WIDE_SCALE).min(WIDE_MAX_ALPHA);
-    (a > r.alpha_u).then(|| {
-        Bsdf::RoughDielectric(RoughDielectric {
-            eta: r.eta,
-            inv_eta: r.inv_eta,
-            distribution: r.distribution,
-            alpha_u: a,
-            alpha_v: a,
-            sample_visible: r.sample_visible,
-            specular_reflectance: None,
-            specular_transmittance: None,
-        })
-    })
+    if !(a > r.alpha_u) {
+        return None;
+    }
+    Some(Bsdf::RoughDielectric(RoughDielectric {
+        eta: r.eta,
+        inv_eta: r.inv_eta,
+        distribution: r.distribution,
+        alpha_u: a,
+        alpha_v: a,
+        sample_visible: r.sample_visible,
+        specular_reflectance: None,
+        specular_transmittance: None,
+    }))
 }
 
 /// The one-sample mixture `(1 − s) · lobe + s · wide lobe` (`s` = [`WIDE_SHARE`], the wide lobe
