@@ -7,9 +7,11 @@
 //! otherwise, front side only), then a reference ([`point_reference`]: a shading frame and the
 //! direction `omega_ref` from the refined boundary point towards `y`, a deterministic function
 //! of `(x_j, y)`), then the inner direction `omega_in ~ bsdf.sample(wi = omega_ref)` in
-//! importance mode in that frame, `omega_jk = −omega_in`, and traces `x_j → x_k`. The value uses
-//! the TRUE BSDF at `x_k` (its own shading frame) and the real emitter direction
-//! `omega_l = (y − x_k)/|y − x_k|`, with the light segment `x_k → y` through passable surfaces.
+//! importance mode in that frame (on a curved boundary mixed with a wider lobe,
+//! `rough_lobe::sample_inner_ref`, whose density `p_imp` below then is), `omega_jk = −omega_in`,
+//! and traces `x_j → x_k`. The value uses the TRUE BSDF at `x_k` (its own shading frame) and the
+//! real emitter direction `omega_l = (y − x_k)/|y − x_k|`, with the light segment `x_k → y`
+//! through passable surfaces.
 //!
 //! Density, in the measure of the other techniques (`rough_lobe::rough_pdfs`: solid angle of `omega_jk`
 //! at `x_j` times solid angle of `omega_l` at `x_k`), conditioned on `x_j`:
@@ -192,7 +194,7 @@ pub fn point_reference(
                     _ => break,
                 }
             }
-            let reference = Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf };
+            let reference = Reference::of_point(scene, &si);
             Some((reference, towards(si.p)))
         }
     }
@@ -229,7 +231,7 @@ pub fn density(
         return 0.0;
     }
     let Some((r, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else { return 0.0 };
-    let p_imp = rough_lobe::pdf_inner_in(&scene.bsdfs[r.bsdf as usize], r.frame, omega_ref, omega_jk);
+    let p_imp = rough_lobe::pdf_inner_ref(scene, &r, omega_ref, omega_jk);
     combine(p_y, p_imp, si_k, end)
 }
 
@@ -306,8 +308,7 @@ pub fn connect(
     let Some((reference, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else {
         return fail(stats);
     };
-    let bsdf_ref = &scene.bsdfs[reference.bsdf as usize];
-    let omega_jk = rough_lobe::sample_inner_in(bsdf_ref, reference.frame, omega_ref, u1, u2)?;
+    let omega_jk = rough_lobe::sample_inner_ref(scene, &reference, omega_ref, u1, u2)?;
     let Some(si_k) = rough_lobe::trace_inner(scene, x_j, plane, omega_jk, stats) else {
         return fail(stats);
     };
@@ -321,7 +322,7 @@ pub fn connect(
     if tr == Spectrum::ZERO || le == Spectrum::ZERO {
         return fail(stats);
     }
-    let p_imp = rough_lobe::pdf_inner_in(bsdf_ref, reference.frame, omega_ref, omega_jk);
+    let p_imp = rough_lobe::pdf_inner_ref(scene, &reference, omega_ref, omega_jk);
     let p_man = combine(p_y, p_imp, &si_k, &end);
     if !(p_man > 0.0) {
         return fail(stats);

@@ -9,6 +9,7 @@
 use super::planes::{RoughPlane, SAME_NORMAL};
 use super::MediumVertex;
 use crate::bsdf::fresnel::{fresnel, refract};
+use crate::bsdf::rough_dielectric::RoughDielectric;
 use crate::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use crate::integrator::snee::{with_wi, LightSample, SneeOptions, SneeVertex};
 use crate::integrator::stats::LocalStats;
@@ -19,18 +20,27 @@ use crate::scene::world::Scene;
 /// Where the connection samples the inner direction: a shading frame and a `roughdielectric`
 /// (index into `Scene::bsdfs`). Flat: the plane's ([`Reference::of_plane`]); curved: the shading
 /// frame where the straight line from `x_j` towards the light meets the boundary
-/// ([`curved_reference`]).
+/// ([`curved_reference`]). `wide`: the connection samples the mixture with a wider lobe
+/// ([`sample_inner_ref`], docs/manifold.md §7.1 "Defensive lobe"), set for curved boundaries
+/// only (on a plane the frame is `x_k`'s own).
 #[derive(Clone, Copy, Debug)]
 pub struct Reference {
     pub frame: Frame,
     pub bsdf: u32,
+    pub wide: bool,
 }
 
 impl Reference {
     /// The frame of a flat orientation (any tangent: the roughness is isotropic).
     #[inline]
     pub fn of_plane(plane: &RoughPlane) -> Self {
-        Reference { frame: Frame::from_normal(plane.n), bsdf: plane.bsdf }
+        Reference { frame: Frame::from_normal(plane.n), bsdf: plane.bsdf, wide: false }
+    }
+
+    /// The shading frame and BSDF of the boundary point `si` of a curved boundary (`wide`).
+    #[inline]
+    pub fn of_point(scene: &Scene, si: &SurfaceInteraction) -> Self {
+        Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf, wide: true }
     }
 }
 
@@ -55,7 +65,7 @@ pub fn curved_reference(
     if !on_boundary(scene, &si0, medium, omega_l) {
         return None;
     }
-    let of = |si: &SurfaceInteraction| Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf };
+    let of = |si: &SurfaceInteraction| Reference::of_point(scene, si);
     let mut si = si0;
     for _ in 0..REFINE_STEPS {
         let Bsdf::RoughDielectric(b) = scene.bsdf(&si) else { break };
@@ -132,6 +142,79 @@ pub fn pdf_inner_in(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, omega_jk: Vec3) ->
         p
     } else {
         0.0
+    }
+}
+
+/// Share of the wide lobe in the defensive mixture of a curved reference (docs/manifold.md §7.1,
+/// "Defensive lobe").
+pub const WIDE_SHARE: f32 = 0.5;
+/// The wide lobe's roughness: the reference BSDF's `alpha` times this, at most [`WIDE_MAX_ALPHA`].
+pub const WIDE_SCALE: f32 = 8.0;
+/// Cap of the wide lobe's roughness.
+pub const WIDE_MAX_ALPHA: f32 = 0.5;
+
+/// The wide lobe of `bsdf` (a `roughdielectric`; `None` for anything else or when widening
+/// changes nothing): the same distribution and index, roughness `min(alpha · WIDE_SCALE,
+/// WIDE_MAX_ALPHA)`. The textures are left out: they weigh the value, not the density.
+pub fn widened(bsdf: &Bsdf) -> Option<Bsdf> {
+    let Bsdf::RoughDielectric(r) = bsdf else { return None };
+    let a = (r.alpha_u * WIDE_SCALE).min(WIDE_MAX_ALPHA);
+    if !(a > r.alpha_u) {
+        return None;
+    }
+    Some(Bsdf::RoughDielectric(RoughDielectric {
+        eta: r.eta,
+        inv_eta: r.inv_eta,
+        distribution: r.distribution,
+        alpha_u: a,
+        alpha_v: a,
+        sample_visible: r.sample_visible,
+        specular_reflectance: None,
+        specular_transmittance: None,
+    }))
+}
+
+/// The one-sample mixture `(1 − s) · lobe + s · wide lobe` (`s` = [`WIDE_SHARE`], the wide lobe
+/// [`widened`]) of [`sample_inner_in`] in `frame`: `u2.x` picks the component and is reused.
+/// [`sample_inner_in`] itself where there is no wider lobe. Density: [`pdf_inner_mixture`].
+pub fn sample_inner_mixture(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, u1: f32, u2: Vec2) -> Option<Vec3> {
+    let Some(wide) = widened(bsdf) else { return sample_inner_in(bsdf, frame, omega_l, u1, u2) };
+    let s = WIDE_SHARE;
+    let below = 1.0 - f32::EPSILON;
+    if u2.x < s {
+        sample_inner_in(&wide, frame, omega_l, u1, Vec2::new((u2.x / s).min(below), u2.y))
+    } else {
+        sample_inner_in(bsdf, frame, omega_l, u1, Vec2::new(((u2.x - s) / (1.0 - s)).min(below), u2.y))
+    }
+}
+
+/// Solid-angle density of [`sample_inner_mixture`]'s `omega_jk`.
+pub fn pdf_inner_mixture(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, omega_jk: Vec3) -> f64 {
+    let p = pdf_inner_in(bsdf, frame, omega_l, omega_jk);
+    let Some(wide) = widened(bsdf) else { return p };
+    let s = WIDE_SHARE as f64;
+    (1.0 - s) * p + s * pdf_inner_in(&wide, frame, omega_l, omega_jk)
+}
+
+/// The connection's inner-direction sample in `reference` towards the light along `omega_l`:
+/// [`sample_inner_mixture`] for a `wide` (curved) reference, [`sample_inner_in`] on a plane.
+/// Density: [`pdf_inner_ref`].
+pub fn sample_inner_ref(scene: &Scene, reference: &Reference, omega_l: Vec3, u1: f32, u2: Vec2) -> Option<Vec3> {
+    let bsdf = &scene.bsdfs[reference.bsdf as usize];
+    if reference.wide {
+        sample_inner_mixture(bsdf, reference.frame, omega_l, u1, u2)
+    } else {
+        sample_inner_in(bsdf, reference.frame, omega_l, u1, u2)
+    }
+}
+
+/// Solid-angle density of [`sample_inner_ref`]'s `omega_jk`.
+pub fn pdf_inner_ref(scene: &Scene, reference: &Reference, omega_l: Vec3, omega_jk: Vec3) -> f64 {
+    let bsdf = &scene.bsdfs[reference.bsdf as usize];
+    if reference.wide {
+        pdf_inner_mixture(bsdf, reference.frame, omega_l, omega_jk)
+    } else {
+        pdf_inner_in(bsdf, reference.frame, omega_l, omega_jk)
     }
 }
 
@@ -217,9 +300,7 @@ pub fn rough_pdfs(
         fwd * bsdf.pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l)) as f64
     };
     let manifold = match reference {
-        Some(r) if !light.dist.is_finite() => {
-            light.p_light as f64 * pdf_inner_in(&scene.bsdfs[r.bsdf as usize], r.frame, light.omega_l, omega_jk)
-        }
+        Some(r) if !light.dist.is_finite() => light.p_light as f64 * pdf_inner_ref(scene, r, light.omega_l, omega_jk),
         _ => 0.0,
     };
     let cos_k = omega_jk.dot(si_k.n).abs() as f64;
