@@ -54,14 +54,8 @@ const FD_STEP: f64 = 1e-6;
 /// expected number of draws per connection stays below `1 + (number of solutions)` whatever the cap.
 pub const MAX_TRIALS: u32 = super::newton::DIRECTIONAL_MAX_TRIALS;
 
-/// Where the chain's rays meet the boundary (the caller's ray casts).
-pub trait ChainLocate {
-    /// First hit from the medium vertex `x_j` along `d`: the patch and the geometric normal there;
-    /// `None` unless it is the medium's enclosing smooth boundary, met from inside.
-    fn first(&mut self, x_j: DVec3, d: DVec3) -> Option<(Patch, DVec3)>;
-    /// First hit from `x_1` (on the boundary, geometric normal `n_1`) along the reflected `d`.
-    fn second(&mut self, x_1: DVec3, n_1: DVec3, d: DVec3) -> Option<Patch>;
-}
+/// Where the chain's rays meet the boundary; declared beside the seeds, which cast the same rays.
+pub use super::chain_seed::ChainLocate;
 
 /// The closed-form chain through two fixed patches at `omega`.
 #[derive(Clone, Copy, Debug)]

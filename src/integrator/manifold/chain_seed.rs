@@ -25,9 +25,18 @@
 //! 2020, §4.3), and the uniform part gives every solution a positive probability (density at least
 //! `P_UNIFORM / 4π`).
 
-use super::chain::ChainLocate;
 use super::newton::sphere_seed;
+use super::newton::Patch;
 use crate::math::DVec3;
+
+/// Where the chain's rays meet the boundary (the caller's ray casts).
+pub trait ChainLocate {
+    /// First hit from the medium vertex `x_j` along `d`: the patch and the geometric normal there;
+    /// `None` unless it is the medium's enclosing smooth boundary, met from inside.
+    fn first(&mut self, x_j: DVec3, d: DVec3) -> Option<(Patch, DVec3)>;
+    /// First hit from `x_1` (on the boundary, geometric normal `n_1`) along the reflected `d`.
+    fn second(&mut self, x_1: DVec3, n_1: DVec3, d: DVec3) -> Option<Patch>;
+}
 
 /// Probability of a seed uniform on the sphere in the mixture (the rest: light-side seeds).
 pub const P_UNIFORM: f64 = 0.25;
