@@ -31,7 +31,9 @@
 //! `chain_trials_capped`).
 
 use super::chain_seed::{self, ChainSeeds};
-use super::newton::{bernoulli_trials_capped, damped_step, moved, tangents, Failure, Patch, Refracted};
+use super::newton::{
+    bernoulli_trials_capped, central_jacobian, damped_step, moved, tangents, Failure, Patch, Refracted,
+};
 use super::MediumVertex;
 use crate::bsdf::fresnel::fresnel;
 use crate::color::Spectrum;
@@ -105,15 +107,7 @@ fn jacobian(
     l: (DVec3, DVec3),
 ) -> Option<[[f64; 2]; 2]> {
     let t = tangents(omega);
-    let mut j = [[0.0; 2]; 2];
-    for (col, (a, b)) in [(FD_STEP, 0.0), (0.0, FD_STEP)].into_iter().enumerate() {
-        let plus = residual(&chain_map(p1, p2, x_j, moved(omega, t, a, b))?, l, omega_l);
-        let minus = residual(&chain_map(p1, p2, x_j, moved(omega, t, -a, -b))?, l, omega_l);
-        for row in 0..2 {
-            j[row][col] = (plus[row] - minus[row]) / (2.0 * FD_STEP);
-        }
-    }
-    Some(j)
+    central_jacobian(FD_STEP, |a, b| Some(residual(&chain_map(p1, p2, x_j, moved(omega, t, a, b))?, l, omega_l)))
 }
 
 /// Locate both patches along `omega` (two ray casts) and evaluate the chain through them.

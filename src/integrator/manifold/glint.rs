@@ -44,7 +44,7 @@
 //! filters would need a splat at `u_s` (not done: the glints are off there). Internal reflections
 //! between the two refractions and chains of more interfaces are left out (docs/manifold.md §10).
 
-use super::newton::{bernoulli_trials_capped, tangents, Patch, Refracted};
+use super::newton::{bernoulli_trials_capped, central_jacobian, tangents, Patch, Refracted};
 use crate::bsdf::fresnel::fresnel;
 use crate::color::Spectrum;
 use crate::emitter::Emitter;
@@ -254,15 +254,10 @@ fn jacobian(
     omega_l: DVec3,
     l: (DVec3, DVec3),
 ) -> Option<[[f64; 2]; 2]> {
-    let mut j = [[0.0; 2]; 2];
-    for (col, step) in [DVec2::new(FD_STEP, 0.0), DVec2::new(0.0, FD_STEP)].into_iter().enumerate() {
-        let plus = residual(&glint_map(chain, p1, p2, cam.origin, cam.direction(u + step))?, l, omega_l);
-        let minus = residual(&glint_map(chain, p1, p2, cam.origin, cam.direction(u - step))?, l, omega_l);
-        for row in 0..2 {
-            j[row][col] = (plus[row] - minus[row]) / (2.0 * FD_STEP);
-        }
-    }
-    Some(j)
+    central_jacobian(FD_STEP, |a, b| {
+        let moved = u + DVec2::new(a, b);
+        Some(residual(&glint_map(chain, p1, p2, cam.origin, cam.direction(moved))?, l, omega_l))
+    })
 }
 
 /// A converged, located glint.

@@ -208,18 +208,25 @@ fn residual(r: &Refracted, omega_l: DVec3, l: (DVec3, DVec3)) -> [f64; 2] {
     [v.dot(l.0), v.dot(l.1)]
 }
 
-/// `dC/d(a, b)` at `omega` on `patch` (columns: a, b), by central differences of the closed form.
-fn jacobian(patch: &Patch, x_j: DVec3, omega: DVec3, omega_l: DVec3, l: (DVec3, DVec3)) -> Option<[[f64; 2]; 2]> {
-    let t = tangents(omega);
+/// The 2×2 Jacobian of a residual `r(a, b)` at `(0, 0)` by central differences with step `h`:
+/// column 0 is `(r(h, 0) − r(−h, 0)) / 2h`, column 1 `(r(0, h) − r(0, −h)) / 2h`; `None` when `r` is
+/// undefined at one of the four points. Shared by every Newton solve of the manifold connections.
+pub fn central_jacobian(h: f64, mut r: impl FnMut(f64, f64) -> Option<[f64; 2]>) -> Option<[[f64; 2]; 2]> {
     let mut j = [[0.0; 2]; 2];
-    for (col, (a, b)) in [(FD_STEP, 0.0), (0.0, FD_STEP)].into_iter().enumerate() {
-        let plus = residual(&patch.refract(x_j, moved(omega, t, a, b))?, omega_l, l);
-        let minus = residual(&patch.refract(x_j, moved(omega, t, -a, -b))?, omega_l, l);
+    for (col, (a, b)) in [(h, 0.0), (0.0, h)].into_iter().enumerate() {
+        let plus = r(a, b)?;
+        let minus = r(-a, -b)?;
         for row in 0..2 {
-            j[row][col] = (plus[row] - minus[row]) / (2.0 * FD_STEP);
+            j[row][col] = (plus[row] - minus[row]) / (2.0 * h);
         }
     }
     Some(j)
+}
+
+/// `dC/d(a, b)` at `omega` on `patch` (columns: a, b), by central differences of the closed form.
+fn jacobian(patch: &Patch, x_j: DVec3, omega: DVec3, omega_l: DVec3, l: (DVec3, DVec3)) -> Option<[[f64; 2]; 2]> {
+    let t = tangents(omega);
+    central_jacobian(FD_STEP, |a, b| Some(residual(&patch.refract(x_j, moved(omega, t, a, b))?, omega_l, l)))
 }
 
 /// A converged, located solution.

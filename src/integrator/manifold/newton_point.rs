@@ -27,7 +27,9 @@
 //! direction `y − x_k⁰` into the medium there and reverse it. A function of `(x_j, y)` only, so the
 //! technique's density of a given suffix can be evaluated by re-solving from that seed.
 
-use super::newton::{damped_step, moved, tangents, Failure, Locate, Patch, Refracted, MAX_ITERATIONS};
+use super::newton::{
+    central_jacobian, damped_step, moved, tangents, Failure, Locate, Patch, Refracted, MAX_ITERATIONS,
+};
 use crate::math::DVec3;
 
 /// Converged when `|Φ − y| < TOLERANCE · |y − x_j|`.
@@ -72,15 +74,7 @@ fn residual(p: DVec3, y: DVec3, lt: (DVec3, DVec3)) -> [f64; 2] {
 fn jacobian(patch: &Patch, x_j: DVec3, omega: DVec3, y: DVec3, l: DVec3) -> Option<[[f64; 2]; 2]> {
     let t = tangents(omega);
     let lt = tangents(l);
-    let mut j = [[0.0; 2]; 2];
-    for (col, (a, b)) in [(FD_STEP, 0.0), (0.0, FD_STEP)].into_iter().enumerate() {
-        let plus = residual(beam(patch, x_j, moved(omega, t, a, b), y, l)?.1, y, lt);
-        let minus = residual(beam(patch, x_j, moved(omega, t, -a, -b), y, l)?.1, y, lt);
-        for row in 0..2 {
-            j[row][col] = (plus[row] - minus[row]) / (2.0 * FD_STEP);
-        }
-    }
-    Some(j)
+    central_jacobian(FD_STEP, |a, b| Some(residual(beam(patch, x_j, moved(omega, t, a, b), y, l)?.1, y, lt)))
 }
 
 /// The generalized geometry term `G = dω/dA⊥(y)` at a solution `omega` (refracting into `o`):
