@@ -402,6 +402,13 @@ mod tests {
     use crate::math::Frame;
     use crate::testing::chi2::{chi2_sphere, sidak};
 
+    /// A frame about `n` whose tangent is turned by `angle` from `Frame::from_normal`'s.
+    fn rotated_frame(n: Vec3, angle: f32) -> Frame {
+        let base = Frame::from_normal(n);
+        let (c, s) = (angle.cos(), angle.sin());
+        Frame { s: base.s * c + base.t * s, t: base.t * c - base.s * s, n }
+    }
+
     fn rough(kind: MicrofacetType, alpha: f32, eta: f32) -> Bsdf {
         Bsdf::RoughDielectric(RoughDielectric {
             eta,
@@ -447,10 +454,7 @@ mod tests {
     /// 70° off the frame's normal. Sample counts chosen before the first run.
     #[test]
     fn inner_direction_sampling_in_a_shading_frame_matches_pdf() {
-        let n = Vec3::new(-0.4, 0.1, 0.9).normalize();
-        let base = Frame::from_normal(n);
-        let (c, s) = (0.6f32.cos(), 0.6f32.sin());
-        let frame = Frame { s: base.s * c + base.t * s, t: base.t * c - base.s * s, n };
+        let frame = rotated_frame(Vec3::new(-0.4, 0.1, 0.9).normalize(), 0.6);
         let cases = [(0.2, 0.0), (0.2, 1.2), (0.04, 0.5), (0.04, 1.2)];
         let level = sidak(0.01, cases.len());
         for (alpha, theta) in cases {
@@ -476,10 +480,7 @@ mod tests {
     /// frame with a rotated tangent. Sample counts chosen before the first run.
     #[test]
     fn defensive_mixture_sampling_matches_pdf() {
-        let n = Vec3::new(0.3, 0.2, 0.9).normalize();
-        let base = Frame::from_normal(n);
-        let (c, s) = (1.1f32.cos(), 1.1f32.sin());
-        let frame = Frame { s: base.s * c + base.t * s, t: base.t * c - base.s * s, n };
+        let frame = rotated_frame(Vec3::new(0.3, 0.2, 0.9).normalize(), 1.1);
         let cases = [
             (MicrofacetType::Ggx, 0.04, 1.5, 0.0),
             (MicrofacetType::Ggx, 0.04, 1.5, 1.2),
