@@ -178,18 +178,15 @@ pub fn shadow_ray(scene: &Scene, r: RefPoint, medium: Option<u32>, ds: &Directio
 /// Where a shadow ray crosses the surface of `hit` (found along `ray`): the point, the geometric
 /// normal, and the surface's null transmission (Mitsuba's `eval_null_transmission`), which is all a
 /// shadow walk needs of it. A mesh with a `null` BSDF (an index-matched medium boundary) transmits 1
-/// and needs only the point and the face normal, computed here with `Mesh::interaction`'s
-/// operations (so the same bits) without its shading frame; anything else gets the full
+/// and needs only the point and the face normal (`Mesh::point_and_normal`, which
+/// `Mesh::interaction` also uses), not its shading frame; anything else gets the full
 /// `SurfaceInteraction`.
 #[inline]
 pub fn shadow_crossing(scene: &Scene, hit: &Hit, ray: &Ray) -> (Vec3, Vec3, Spectrum) {
     let shape = &scene.shapes[hit.shape as usize];
     if let (Geometry::Mesh(m), Bsdf::Null) = (&shape.geometry, &scene.bsdfs[shape.bsdf as usize]) {
-        let [p0, p1, p2] = m.indices[hit.prim as usize].map(|i| m.positions[i as usize]);
-        let b0 = 1.0 - hit.b1 - hit.b2;
-        let p = p0 * b0 + p1 * hit.b1 + p2 * hit.b2;
-        let face_n = m.face_normals[hit.prim as usize];
-        return (p, if m.flip_normals { -face_n } else { face_n }, Spectrum::ONE);
+        let (p, n) = m.point_and_normal(hit.prim, hit.b1, hit.b2);
+        return (p, n, Spectrum::ONE);
     }
     let mut si = shape.interaction(hit.prim, hit.b1, hit.b2, hit.t, ray);
     si.shape = hit.shape;

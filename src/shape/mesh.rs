@@ -208,6 +208,17 @@ impl Mesh {
         b
     }
 
+    /// The point at barycentrics `(b1, b2)` of triangle `prim` and its geometric normal (flipped
+    /// with `flip_normals`): the part of [`Mesh::interaction`] that a shadow ray crossing the mesh
+    /// needs (`walk::shadow_crossing`).
+    #[inline]
+    pub fn point_and_normal(&self, prim: u32, b1: f32, b2: f32) -> (Vec3, Vec3) {
+        let [p0, p1, p2] = self.indices[prim as usize].map(|i| self.positions[i as usize]);
+        let b0 = 1.0 - b1 - b2;
+        let face_n = self.face_normals[prim as usize];
+        (p0 * b0 + p1 * b1 + p2 * b2, if self.flip_normals { -face_n } else { face_n })
+    }
+
     /// The corner, edges, normal and corner uvs of triangle `prim` (see [`SampleTriangle`]).
     #[inline(always)]
     fn sample_triangle(&self, prim: u32) -> SampleTriangle {
@@ -217,20 +228,18 @@ impl Mesh {
         let uv = if self.uvs.is_empty() { [Vec2::ZERO, Vec2::X, Vec2::Y] } else { idx.map(|i| self.uvs[i as usize]) };
         SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: if self.flip_normals { -n } else { n }, uv }
     }
+
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
         let idx = self.indices[prim as usize];
-        let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
+        let (p, n) = self.point_and_normal(prim, b1, b2);
         let b0 = 1.0 - b1 - b2;
-        let p = p0 * b0 + p1 * b1 + p2 * b2;
         let uv = if self.uvs.is_empty() {
             Vec2::new(b1, b2)
         } else {
             let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
             u0 * b0 + u1 * b1 + u2 * b2
         };
-        let face_n = self.face_normals[prim as usize];
-        let n = if self.flip_normals { -face_n } else { face_n };
         let sh_frame = match self.face_frames.get(prim as usize) {
             Some(frame) => *frame,
             None => {
@@ -245,7 +254,7 @@ impl Mesh {
     /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges).
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
         let total = self.surface_area();
-        // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf, as before).
+        // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf).
         let (prim, sx, _) = self.area_distr.sample(sample.x).unwrap_or((0, 0.5, 0.0));
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
         let tri = match self.sample_triangles.get(prim) {
