@@ -20,6 +20,7 @@
 
 use crate::color::Spectrum;
 use crate::emitter::Emitter;
+use crate::integrator::desc::Integrator;
 use crate::integrator::snee::{SneeTechnique, SneeTransport};
 use crate::integrator::{IntegratorDesc, IntegratorKind};
 use crate::medium::{Homogeneous, Phase};
@@ -199,6 +200,11 @@ fn snee_params(integ: &IntegratorDesc) -> Option<(&'static str, &'static str, Op
     Some((technique, transport, integ.snee.rate))
 }
 
+/// Does `volpath_snee` run volpath's loop in `scene` (`Snee::forward_only`)?
+fn forward_only(scene: &Scene) -> bool {
+    matches!(&scene.integrator, Integrator::VolpathSnee(_, s) if s.forward_only)
+}
+
 pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
     let film = &scene.film;
     let sampler = &scene.sampler;
@@ -240,6 +246,7 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         // Which estimator runs (the paper's, or the complete one with manifold NEE).
         integ_json["connection"] = json!(integ.connection.name());
         integ_json["reflection_chains"] = json!(integ.snee.chains);
+        integ_json["forward_only"] = json!(forward_only(scene));
     }
     let json = json!({
         "plugins": tree_json(&parsed.root, None),
@@ -296,6 +303,9 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         let rate = rate.map_or_else(|| "per medium (default)".to_string(), num);
         let _ = write!(text, ", snee = {technique}, transport = {transport}, snee_rate = {rate}");
         let _ = write!(text, ", connection = {}", integ.connection.name());
+        if forward_only(scene) {
+            let _ = write!(text, " (nothing of it applies here: renders with volpath's loop)");
+        }
     }
     let _ = writeln!(text, "{}", if integ.moment { " (inside moment: also m2.R, m2.G, m2.B)" } else { "" });
     Summary { json, text }

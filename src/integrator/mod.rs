@@ -147,6 +147,9 @@ impl Integrator {
                 let roulette = volpathmis::RouletteMis::Unbiased;
                 volpathmis::li_tally(scene, sampler, ray, medium, stats, roulette, &mut tally)
             }
+            Integrator::VolpathSnee(_, snee) if snee.forward_only => {
+                volpath::li_tally(scene, sampler, ray, medium, stats, None, &mut tally)
+            }
             Integrator::VolpathSnee(_, snee) => {
                 let (l, valid) = volpath::li_tally(scene, sampler, ray, medium, stats, Some(snee), &mut tally);
                 // Glints (`manifold/glint.rs`): class `surface`.

@@ -25,10 +25,11 @@ use super::snee::{self, Snee, SneeOptions, SneeTechnique, SneeTransport};
 use super::stats::LocalStats;
 use super::volpath;
 use crate::color::Spectrum;
+use crate::emitter::Emitter;
 use crate::math::Ray;
 use crate::sampler::Sampler;
 use crate::scene::desc::Props;
-use crate::scene::world::Scene;
+use crate::scene::world::{Scene, SceneEmitter};
 use crate::scene::Result;
 
 /// Radiance along a camera ray: volpath's loop with SNEE as one stage.
@@ -40,6 +41,9 @@ pub fn li(
     medium: Option<u32>,
     stats: &mut LocalStats,
 ) -> (Spectrum, bool) {
+    if snee.forward_only {
+        return volpath::li(scene, sampler, ray, medium, stats);
+    }
     let (l, valid) = volpath::li_with(scene, sampler, ray, medium, stats, Some(snee));
     // Glints from the camera (`connection = complete`, docs/manifold.md §10); zero, drawing nothing, elsewhere.
     (l + manifold::glint::sample(scene, snee, sampler, &ray, stats), valid)
@@ -102,5 +106,31 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
         snee::rate::complete_rates(scene, &mut snee);
     }
+    snee.forward_only = forward_only(scene, &snee, connection);
     snee
+}
+
+/// Does nothing of `volpath_snee` run in `scene`? Then its loop would draw the same numbers and
+/// compute the same image as volpath's (bit for bit), only slower: it would still track every
+/// medium vertex and boundary crossing for MIS weights that all come out as volpath's. That holds
+/// when all transport is kept, SNEE never runs (`snee = forward`, or every medium's rate is 0 or
+/// SNEE does not apply), and with `connection = complete` no connection serves the scene: no flat
+/// or rough boundary, and curved boundaries lit only by environments (`envmap`, `constant`),
+/// which neither the curved connections nor the glints take (docs/manifold.md §8.2, §10).
+pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool {
+    let options = &snee.options;
+    let no_snee = options.technique == SneeTechnique::Forward || snee.rates.iter().all(|r| r.is_none_or(|r| r == 0.0));
+    let no_connection = match connection {
+        Connection::Paper => true,
+        Connection::Complete => {
+            snee.flat.iter().all(Option::is_none)
+                && snee.rough.iter().all(Option::is_none)
+                && (snee.curved.iter().all(|c| !c)
+                    || scene
+                        .emitters
+                        .iter()
+                        .all(|e| matches!(e, SceneEmitter::Other(Emitter::Envmap(_) | Emitter::Constant(_)))))
+        }
+    };
+    options.keeps_all() && no_snee && no_connection
 }

@@ -93,3 +93,57 @@ fn rate_out_of_range_is_an_error() {
     let s = err.to_string();
     assert!(s.starts_with("rate.xml:2:") && s.contains("snee_rate must be in [0, 1]"), "{}", s);
 }
+
+/// A glass (smooth `dielectric`) sphere of thin medium (optical size 2 < 4, so SNEE's rate under
+/// `complete` is 0, docs/snee.md §5) lit by `emitter`.
+fn smooth_sphere(integrator: &str, extra: &str, emitter: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
+<integrator type="{integrator}"><integer name="max_depth" value="12"/>{extra}</integrator>
+<sensor type="perspective"><float name="fov" value="30"/>
+    <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film></sensor>
+{emitter}
+<medium type="homogeneous" id="m"><float name="sigma_t" value="1"/><rgb name="albedo" value="0.9, 0.8, 0.7"/></medium>
+<shape type="sphere"><float name="radius" value="1"/>
+    <bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf>
+    <ref name="interior" id="m"/></shape>
+</scene>"#
+    )
+}
+
+const ENVMAP: &str = r#"<emitter type="envmap"><string name="filename" value="textures/sky.exr"/></emitter>"#;
+const SPHERE_LIGHT: &str = r#"<shape type="sphere"><point name="center" x="3" y="4" z="2"/><float name="radius" value="0.3"/>
+    <emitter type="area"><rgb name="radiance" value="40, 40, 40"/></emitter></shape>"#;
+
+fn forward_only(scene: &snee::scene::world::Scene) -> bool {
+    match &scene.integrator {
+        snee::integrator::desc::Integrator::VolpathSnee(_, s) => s.forward_only,
+        _ => panic!("not volpath_snee"),
+    }
+}
+
+/// Where nothing of `volpath_snee` runs (`Snee::forward_only`), it renders with volpath's loop:
+/// the same statistics and ray counts, bit for bit. The rule is decided at scene load; where a
+/// technique applies (a sphere light, which the curved connection serves; SNEE at its default
+/// rate under `paper`) the loop is `volpath_snee`'s.
+#[test]
+fn forward_only_where_nothing_applies() {
+    let complete = r#"<string name="connection" value="complete"/>"#;
+    let vp = scene(&smooth_sphere("volpath", "", ENVMAP), &[]);
+    let idle = scene(&smooth_sphere("volpath_snee", complete, ENVMAP), &[]);
+    assert!(forward_only(&idle));
+    let (a, b) = (render_batches(&vp, 2, 4, 8, 9000), render_batches(&idle, 2, 4, 8, 9000));
+    assert_eq!((a.stats, a.rays), (b.stats, b.rays));
+    // `snee = forward` is volpath wherever SNEE applies (here: rough glass, default rate).
+    let fwd = scene(&xml("volpath_snee", r#"<string name="snee" value="forward"/>"#), &[]);
+    assert!(forward_only(&fwd));
+    let (a, b) = (render_batches(&scene(&xml("volpath", ""), &[]), 2, 4, 8, 9100), render_batches(&fwd, 2, 4, 8, 9100));
+    assert_eq!((a.stats, a.rays), (b.stats, b.rays));
+    // Techniques that apply keep volpath_snee's loop.
+    assert!(!forward_only(&scene(&smooth_sphere("volpath_snee", complete, SPHERE_LIGHT), &[])));
+    assert!(!forward_only(&scene(&smooth_sphere("volpath_snee", "", SPHERE_LIGHT), &[])));
+    assert!(!forward_only(&scene(&xml("volpath_snee", ""), &[])));
+    let snee_only = r#"<string name="transport" value="snee"/><float name="snee_rate" value="0"/>"#;
+    assert!(!forward_only(&scene(&xml("volpath_snee", snee_only), &[])));
+}

@@ -76,6 +76,10 @@ pub struct Snee {
     pub rough: Vec<Option<crate::integrator::manifold::planes::RoughBoundary>>,
     /// Per medium: does the curved connection apply (`manifold::curved::curved_boundaries`)?
     pub curved: Vec<bool>,
+    /// Nothing of `volpath_snee` runs in this scene (no SNEE rate above 0, no manifold connection
+    /// or glint that serves its emitters, all transport kept): `li` is then volpath's loop,
+    /// bit for bit (`volpath_snee::forward_only`, docs/snee.md §5).
+    pub forward_only: bool,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).
