@@ -232,7 +232,6 @@ pub fn render_range(
         }
     }
     let nch = channels.len();
-    let ray_weight = scene.camera.ray_weight();
     let total_spp = total_spp(scene, opts);
     let (start_sample, end_sample) = match range {
         Some((s, e)) => (s.min(total_spp), e.min(total_spp)),
@@ -267,7 +266,7 @@ pub fn render_range(
         |sampler: &mut Sampler, local: &mut LocalStats, x: i32, y: i32, split: Option<&mut ClassValues>| {
             let pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
             let aperture = sampler.next_2d();
-            let ray = scene.camera.sample_ray(pos, aperture);
+            let (ray, ray_weight) = crate::integrator::primary_ray(scene, pos, aperture);
             let finite = |l: Spectrum| l.is_finite() && (!moment || (l * l).is_finite());
             match split {
                 None => {

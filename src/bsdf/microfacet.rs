@@ -34,7 +34,7 @@ pub fn read_distribution(props: &Props) -> Result<MicrofacetType> {
 }
 
 /// A microfacet distribution with (possibly anisotropic) roughness.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MicrofacetDistribution {
     pub kind: MicrofacetType,
     /// Roughness along the tangent (local x).

@@ -99,6 +99,21 @@ pub fn parse(obj: &ObjectDesc) -> Result<IntegratorDesc> {
     })
 }
 
+/// The camera ray through film position `pos` and its importance weight (the camera's own
+/// sampling, except for an irradiance meter facing a rough boundary under `volpath_snee`
+/// `connection = complete`: `manifold::meter_glint`).
+#[inline]
+pub fn primary_ray(scene: &Scene, pos: crate::math::Vec2, aperture: crate::math::Vec2) -> (Ray, f32) {
+    if let (Integrator::VolpathSnee(_, snee), crate::sensor::Camera::IrradianceMeter(meter)) =
+        (&scene.integrator, &scene.camera)
+    {
+        if let Some(glint) = &snee.meter_glint {
+            return glint.sample_ray(meter, pos, aperture);
+        }
+    }
+    (scene.camera.sample_ray(pos, aperture), scene.camera.ray_weight())
+}
+
 /// The integrator for `scene` (whose own `integrator` field is not read), with its tables.
 pub fn build(desc: IntegratorDesc, scene: &Scene) -> Integrator {
     match desc.kind {

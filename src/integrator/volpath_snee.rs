@@ -105,6 +105,7 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         snee.rough = manifold::rough::rough_boundaries(scene);
         snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
         snee::rate::complete_rates(scene, &mut snee);
+        snee.meter_glint = manifold::meter_glint::build(scene);
     }
     snee.forward_only = forward_only(scene, &snee, connection);
     snee
@@ -132,5 +133,5 @@ pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool 
                         .all(|e| matches!(e, SceneEmitter::Other(Emitter::Envmap(_) | Emitter::Constant(_)))))
         }
     };
-    options.keeps_all() && no_snee && no_connection
+    options.keeps_all() && no_snee && no_connection && snee.meter_glint.is_none()
 }

@@ -20,6 +20,7 @@ mod manifold_rough_curved;
 mod manifold_rough_finite;
 mod manifold_slab;
 mod manifold_unbiased;
+mod meter_glint;
 mod snee_degenerate;
 mod snee_slab;
 mod snee_unbiased;

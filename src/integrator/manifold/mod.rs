@@ -40,6 +40,7 @@ pub mod finite;
 pub mod flat;
 pub mod glint;
 pub mod locate;
+pub mod meter_glint;
 pub mod mis;
 pub mod newton;
 pub mod newton_point;

@@ -80,6 +80,9 @@ pub struct Snee {
     /// or glint that serves its emitters, all transport kept): `li` is then volpath's loop,
     /// bit for bit (`volpath_snee::forward_only`, docs/snee.md §5).
     pub forward_only: bool,
+    /// With `connection = complete`: the irradiance meter's direction mixture towards the glints
+    /// of directional lights on the rough boundary it faces (`manifold::meter_glint`).
+    pub meter_glint: Option<crate::integrator::manifold::meter_glint::MeterGlint>,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).
