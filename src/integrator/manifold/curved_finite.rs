@@ -61,9 +61,11 @@ fn resolve(
     stats: &mut LocalStats,
 ) -> Option<(PointSolution, SurfaceInteraction)> {
     let mut locate = SceneLocate { scene, medium: x_j.medium, rays: 0 };
-    let r = newton_point::solve_from_seed(&mut locate, x_j.p.as_dvec3(), y.as_dvec3());
+    let mut solves = 0;
+    let r =
+        newton_point::solve_from_seeds(&mut locate, x_j.p.as_dvec3(), y.as_dvec3(), newton_point::SEEDS, &mut solves);
     stats.rays += locate.rays;
-    stats.manifold_newton_solves += 1;
+    stats.manifold_newton_solves += solves as u64;
     let sol = match r {
         Ok(s) => {
             stats.manifold_newton_iterations += s.iterations as u64;
