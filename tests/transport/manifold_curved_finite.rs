@@ -99,7 +99,7 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
         let finite::Pick::Finite(lp) = finite::pick(&scene, Vec2::new(rng.next_1d(), rng.next_1d())) else {
             panic!("the sphere light is the only emitter")
         };
-        let Some(c) = curved_finite::connect(&scene, opts, Some(&x_i), &x_j, &lp, 0, &mut stats) else { continue };
+        let Some(c) = curved_finite::connect(&scene, opts, Some(&x_i), &x_j, &lp, 0.0, 0, &mut stats) else { continue };
         // The forward path: the same suffix, the light hit along the refracted direction.
         let omega_l = c.light.omega_l;
         let mut hit =
@@ -190,7 +190,7 @@ fn connection_rate_out_of_range_is_an_error() {
 fn diagnose_statue_forward_suffixes_found() {
     use crate::manifold_curved_statue::inside_point;
     use snee::integrator::manifold::locate::{boundary_patch, SceneLocate};
-    use snee::integrator::manifold::newton_point::solve_from_seeds;
+    use snee::integrator::manifold::newton_point::{point_seed, solve_from_seeds};
     use snee::math::{DVec3, Ray, Vec3};
     let sigma_t: f64 = std::env::var("STATUE_SIGMA_T").ok().and_then(|s| s.parse().ok()).unwrap_or(34.0);
     let xml = std::fs::read_to_string(common::root().join("scenes/paper/sphere_smooth_st34.xml")).unwrap();
@@ -242,7 +242,8 @@ fn diagnose_statue_forward_suffixes_found() {
             for (v, &n) in variants.iter().enumerate() {
                 let mut locate = SceneLocate { scene: &scene, medium: 0, rays: 0 };
                 let mut solves = 0;
-                let r = solve_from_seeds(&mut locate, x_j.as_dvec3(), y, n, &mut solves);
+                let first = point_seed(&mut locate, x_j.as_dvec3(), y);
+                let r = solve_from_seeds(&mut locate, x_j.as_dvec3(), y, first, n, &mut solves);
                 cost[v].0 += solves as u64;
                 cost[v].1 += locate.rays;
                 if matches!(r, Ok(s) if (s.omega - w).length() < 1e-4) {
