@@ -99,7 +99,7 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
         let finite::Pick::Finite(lp) = finite::pick(&scene, Vec2::new(rng.next_1d(), rng.next_1d())) else {
             panic!("the sphere light is the only emitter")
         };
-        let Some(c) = curved_finite::connect(&scene, opts, Some(&x_i), &x_j, &lp, 0, &mut stats) else { continue };
+        let Some(c) = curved_finite::connect(&scene, opts, Some(&x_i), &x_j, &lp, 0.0, 0, &mut stats) else { continue };
         // The forward path: the same suffix, the light hit along the refracted direction.
         let omega_l = c.light.omega_l;
         let mut hit =
@@ -172,5 +172,93 @@ fn connection_rate_out_of_range_is_an_error() {
         let err = snee::scene::build::build_scene(&parsed).err().expect("connection_rate must be rejected");
         let s = err.to_string();
         assert!(s.starts_with("q.xml:") && s.contains("connection_rate must be in (0, 1]"), "{}", s);
+    }
+}
+
+/// How often the connection's deterministic procedure (`newton_point::solve_from_seeds`) finds the
+/// suffix a FORWARD path made, on the paper's statue under its sphere light
+/// (`scenes/paper/sphere_smooth_st34.xml`; σt from `STATUE_SIGMA_T`, default 34): a forward hit
+/// the procedure misses keeps MIS weight 1 (docs/manifold.md §8.2), a firefly of `L_e` ≈ 900.
+/// Medium vertices uniform in the medium (those with optical depth below 3 towards the light's
+/// centre), directions uniform in the cone of half-angle 70° around the light's centre, traced to
+/// the boundary, refracted about the interpolated normal in closed form, and kept when the
+/// refracted ray hits the light's front; each such suffix weighs `e^{−σt d_jk}`. Printed per
+/// number of seeds: the weighted share of suffixes the procedure finds, and its mean solves and
+/// rays per call. Ignored: a measurement (~1 min), no assertion.
+#[test]
+#[ignore]
+fn diagnose_statue_forward_suffixes_found() {
+    use crate::manifold_curved_statue::inside_point;
+    use snee::integrator::manifold::locate::{boundary_patch, SceneLocate};
+    use snee::integrator::manifold::newton_point::{point_seed, solve_from_seeds};
+    use snee::math::{DVec3, Ray, Vec3};
+    let sigma_t: f64 = std::env::var("STATUE_SIGMA_T").ok().and_then(|s| s.parse().ok()).unwrap_or(34.0);
+    let xml = std::fs::read_to_string(common::root().join("scenes/paper/sphere_smooth_st34.xml")).unwrap();
+    let xml = xml
+        .replace(
+            r#"<integrator type="$integrator">"#,
+            r#"<integrator type="volpath_snee"><string name="connection" value="complete"/>"#,
+        )
+        .replace(r#"value="statue.ply""#, r#"value="paper/statue.ply""#)
+        .replace(r#"<float name="sigma_t" value="34"/>"#, &format!(r#"<float name="sigma_t" value="{sigma_t}"/>"#));
+    let scene = common::scene(&xml, &[]);
+    let center = Vec3::new(28.6788, 81.9152, 49.6732);
+    let variants = [1usize, 2, 6, 10];
+    let mut rng = snee::sampler::Sampler::new(7, 1);
+    let mut u = move || rng.next_1d() as f64;
+    let (mut total, mut hits) = (0.0f64, 0u32);
+    let mut found = [0.0f64; 4];
+    let mut cost = [(0u64, 0u64); 4];
+    let cos_max = 70f64.to_radians().cos();
+    let mut vertices = 0;
+    while vertices < 300 {
+        let x_j = inside_point(&scene, &mut u);
+        let to_c = (center - x_j).normalize();
+        let Some(si) = scene.ray_intersect(&Ray::new(x_j, to_c)) else { continue };
+        if si.t as f64 * sigma_t > 3.0 {
+            continue;
+        }
+        vertices += 1;
+        let c = to_c.as_dvec3();
+        let (t1, t2) = snee::integrator::manifold::newton::tangents(c);
+        for _ in 0..4000 {
+            let z = 1.0 - u() * (1.0 - cos_max);
+            let phi = 2.0 * std::f64::consts::PI * u();
+            let r = (1.0 - z * z).sqrt();
+            let w = (c * z + t1 * (r * phi.cos()) + t2 * (r * phi.sin())).normalize();
+            let Some(si) = scene.ray_intersect(&Ray::new(x_j, w.as_vec3())) else { continue };
+            let Some(patch) = boundary_patch(&scene, &si, 0, w.as_vec3()) else { continue };
+            let Some(rf) = patch.refract(x_j.as_dvec3(), w) else { continue };
+            let o = rf.o.as_vec3();
+            let start = snee::interaction::offset_origin(si.p, si.n, o);
+            let Some(hit) = scene.ray_intersect(&Ray::new(start, o)) else { continue };
+            if scene.shapes[hit.shape as usize].emitter.is_none() || hit.n.dot(o) >= 0.0 {
+                continue;
+            }
+            let y: DVec3 = hit.p.as_dvec3();
+            let weight = (-sigma_t * rf.t).exp();
+            total += weight;
+            hits += 1;
+            for (v, &n) in variants.iter().enumerate() {
+                let mut locate = SceneLocate { scene: &scene, medium: 0, rays: 0 };
+                let mut solves = 0;
+                let first = point_seed(&mut locate, x_j.as_dvec3(), y);
+                let r = solve_from_seeds(&mut locate, x_j.as_dvec3(), y, first, n, &mut solves);
+                cost[v].0 += solves as u64;
+                cost[v].1 += locate.rays;
+                if matches!(r, Ok(s) if (s.omega - w).length() < 1e-4) {
+                    found[v] += weight;
+                }
+            }
+        }
+    }
+    eprintln!("σt {sigma_t}: {vertices} vertices, {hits} forward suffixes reaching the light");
+    for (v, &n) in variants.iter().enumerate() {
+        eprintln!(
+            "seeds {n:2}: found {:.1} % of the weighted suffixes; {:.2} solves, {:.1} rays per call",
+            100.0 * found[v] / total,
+            cost[v].0 as f64 / hits as f64,
+            cost[v].1 as f64 / hits as f64
+        );
     }
 }

@@ -185,10 +185,8 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     match super::finite::pick(scene, u) {
         super::finite::Pick::Distant => {}
         super::finite::Pick::Finite(lp) if lp.area.is_some() => {
-            if (sampler.next_1d() as f64) >= super::curved_finite::rate(opts) {
-                return Some(Spectrum::ZERO);
-            }
-            return Some(super::curved_finite::sample(scene, opts, x_i, &x_j, &lp, v.beta, channel, stats));
+            let u_rate = sampler.next_1d() as f64;
+            return Some(super::curved_finite::sample(scene, opts, x_i, &x_j, &lp, u_rate, v.beta, channel, stats));
         }
         _ => return Some(Spectrum::ZERO),
     }

@@ -33,37 +33,71 @@ use crate::integrator::snee::light::light_transmission;
 use crate::integrator::snee::{passable, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
-use crate::math::{Ray, Vec3};
+use crate::math::{DVec3, Ray, Vec3};
 use crate::scene::world::{Scene, SceneEmitter};
 use crate::shape::Geometry;
 
-/// Probability that the connection runs at a medium vertex whose emitter sample picked an area
-/// light (a constant, part of its density everywhere): each connection costs a Newton solve
-/// (docs/manifold.md §8.2, "Cost").
+/// The connection's top rate `q_top`: the probability that it runs at a medium vertex whose
+/// emitter sample picked an area light, when the straight line from the vertex towards the light
+/// point leaves the medium at once; deeper vertices run at [`rate_at`]'s lower rate
+/// (docs/manifold.md §8.2, "Cost"; the former constant rate's value, kept).
 pub const RATE: f64 = 0.05;
 
-/// The connection's rate `q` under `opts`: `connection_rate`, else [`RATE`].
+/// The smallest factor [`rate_at`] applies to the top rate (deep vertices keep a positive rate).
+pub const MIN_DEPTH_FACTOR: f64 = 1e-3;
+
+/// The connection's top rate under `opts`: `connection_rate`, else [`RATE`].
 #[inline]
 pub fn rate(opts: SneeOptions) -> f64 {
     opts.connection_rate.map_or(RATE, |q| q as f64)
 }
 
+/// The connection's rate `q(x_j, y) = q_top · max(e^{−σ_t t0}, MIN_DEPTH_FACTOR)` at `x_j` in a
+/// medium of smallest extinction `sigma_t`, with `t0` the distance along the straight line
+/// `x_j → y` to the boundary ([`newton_point::seed_line`]; `None`: factor 1). Proportional to the
+/// transmittance the connection's value carries (`d_jk ≈ t0`), so that the connection runs where it
+/// brings light and its density keeps its ratio to forward tracing's `f_p e^{−σ_t d_jk} (1 − F)`;
+/// a function of `(x_j, y)`, evaluated the same way at the three places that weigh the suffix.
+#[inline]
+pub fn rate_at(q_top: f64, sigma_t: f64, t0: Option<f64>) -> f64 {
+    let factor = t0.map_or(1.0, |t| (-sigma_t * t).exp());
+    q_top * factor.clamp(MIN_DEPTH_FACTOR, 1.0)
+}
+
+/// The straight line `x_j → y` (one ray cast, counted): [`rate_at`]'s rate and the first seed.
+fn seed_line(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_j: &MediumVertex,
+    y: Vec3,
+    stats: &mut LocalStats,
+) -> (f64, Option<DVec3>) {
+    let mut locate = SceneLocate { scene, medium: x_j.medium, rays: 0 };
+    let (t0, first) = newton_point::seed_line(&mut locate, x_j.p.as_dvec3(), y.as_dvec3());
+    stats.rays += locate.rays;
+    let sigma_t = scene.media[x_j.medium as usize].sigma_t.min_element() as f64;
+    (rate_at(rate(opts), sigma_t, t0), first)
+}
+
 /// Two directions are the same solution when they differ by less than this (radians).
 const SAME_SOLUTION: f64 = 1e-4;
 
-/// The deterministic solve from `x_j` towards `y`, verified in the renderer's precision (the f32
+/// The deterministic solve from `x_j` towards `y` (`first`: [`seed_line`]'s seed), verified in the renderer's precision (the f32
 /// hit along the solution is the enclosing boundary from inside, at the solved point with the
 /// solved shading normal, and `y` lies outside both normals there). Counts the Newton work.
 fn resolve(
     scene: &Scene,
     x_j: &MediumVertex,
     y: Vec3,
+    first: Option<DVec3>,
     stats: &mut LocalStats,
 ) -> Option<(PointSolution, SurfaceInteraction)> {
     let mut locate = SceneLocate { scene, medium: x_j.medium, rays: 0 };
-    let r = newton_point::solve_from_seed(&mut locate, x_j.p.as_dvec3(), y.as_dvec3());
+    let mut solves = 0;
+    let (p, y64) = (x_j.p.as_dvec3(), y.as_dvec3());
+    let r = newton_point::solve_from_seeds(&mut locate, p, y64, first, newton_point::SEEDS, &mut solves);
     stats.rays += locate.rays;
-    stats.manifold_newton_solves += 1;
+    stats.manifold_newton_solves += solves as u64;
     let sol = match r {
         Ok(s) => {
             stats.manifold_newton_iterations += s.iterations as u64;
@@ -161,8 +195,8 @@ fn faces(n_y: Vec3, y: Vec3, x_j: Vec3) -> bool {
 }
 
 /// The connection's density of the suffix `x_j → x_k → y` that another technique made along
-/// `omega_jk`: re-solve from the path's own seed `(x_j, y)` and keep `p_sel p_A(y) / (G |cos θ_y|)`
-/// when Newton lands on this `omega_jk`, else 0 (and 0 when [`faces`] is false). `p_y`:
+/// `omega_jk`: re-solve from the path's own seed `(x_j, y)` and keep `q(x_j, y) p_sel p_A(y) / (G
+/// |cos θ_y|)` ([`rate_at`]) when Newton lands on this `omega_jk`, else 0 (and 0 when [`faces`] is false). `p_y`:
 /// `p_sel p_A(y)`; `n_y`, `cos_y` at `y`.
 #[allow(clippy::too_many_arguments)]
 fn density(
@@ -180,10 +214,11 @@ fn density(
         return 0.0;
     }
     stats.manifold_resolves += 1;
-    match resolve(scene, x_j, y, stats) {
+    let (q, first) = seed_line(scene, opts, x_j, y, stats);
+    match resolve(scene, x_j, y, first, stats) {
         Some((sol, _)) if (sol.omega - omega_jk.as_dvec3()).length() < SAME_SOLUTION => {
             stats.manifold_resolve_matches += 1;
-            rate(opts) * mis::area_density(p_y, sol.g, cos_y)
+            q * mis::area_density(p_y, sol.g, cos_y)
         }
         _ => 0.0,
     }
@@ -201,10 +236,11 @@ pub struct PointConnection {
     pub light: LightSample,
 }
 
-/// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`), given that it runs
-/// (probability [`rate`], the caller's draw): solve from the deterministic seed, verify, value
-/// (divided by [`rate`]), and MIS-weight against forward tracing and SNEE. Counts solutions and
-/// failures.
+/// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`), run with
+/// probability `q(x_j, y)` ([`rate_at`]: it runs when the uniform `u_rate` is below it; the straight
+/// line's ray is cast only when `u_rate` is below the top rate [`rate`]): solve from the
+/// deterministic seed, verify, value (divided by `q`), and MIS-weight against forward tracing and
+/// SNEE. Counts solutions and failures.
 #[allow(clippy::too_many_arguments)]
 pub fn connect(
     scene: &Scene,
@@ -212,6 +248,7 @@ pub fn connect(
     x_i: Option<&SneeVertex>,
     x_j: &MediumVertex,
     lp: &LightPoint,
+    u_rate: f64,
     channel: usize,
     stats: &mut LocalStats,
 ) -> Option<PointConnection> {
@@ -224,10 +261,17 @@ pub fn connect(
         return None;
     };
     let n_y = light_normal(scene, *shape, lp.y, n_y);
+    if u_rate >= rate(opts) {
+        return None;
+    }
     if !faces(n_y, lp.y, x_j.p) {
         return fail(stats);
     }
-    let Some((sol, si_k)) = resolve(scene, x_j, lp.y, stats) else { return fail(stats) };
+    let (q, first) = seed_line(scene, opts, x_j, lp.y, stats);
+    if u_rate >= q {
+        return None;
+    }
+    let Some((sol, si_k)) = resolve(scene, x_j, lp.y, first, stats) else { return fail(stats) };
     let to_y = lp.y - si_k.p;
     let d_ky = to_y.length();
     let omega_l = to_y / d_ky;
@@ -249,15 +293,16 @@ pub fn connect(
     let d_jk = si_k.t;
     let eta = sol.patch.eta as f32;
     let f = fresnel(sol.refracted.cos_out as f32, eta).0;
-    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (rate(opts) * lp.p_y);
+    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (q * lp.p_y);
     let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
-    let p_man = rate(opts) * mis::area_density(lp.p_y, sol.g, cos_y);
+    let p_man = q * mis::area_density(lp.p_y, sol.g, cos_y);
     let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
     let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
     Some(PointConnection { value, weight, si_k, omega, light })
 }
 
-/// The connection's weighted contribution at `x_j` (with `beta`), zero when it fails.
+/// The connection's weighted contribution at `x_j` (with `beta`; `u_rate` uniform, [`connect`]),
+/// zero when it does not run or fails.
 #[allow(clippy::too_many_arguments)]
 pub fn sample(
     scene: &Scene,
@@ -265,12 +310,13 @@ pub fn sample(
     x_i: Option<&SneeVertex>,
     x_j: &MediumVertex,
     lp: &LightPoint,
+    u_rate: f64,
     beta: Spectrum,
     channel: usize,
     stats: &mut LocalStats,
 ) -> Spectrum {
     let mut result = Spectrum::ZERO;
-    if let Some(c) = connect(scene, opts, x_i, x_j, lp, channel, stats) {
+    if let Some(c) = connect(scene, opts, x_i, x_j, lp, u_rate, channel, stats) {
         add_finite(&mut result, beta * c.value * c.weight as f32, stats);
     }
     result
