@@ -10,7 +10,7 @@
 //! | `connection` | string  | `paper` (default): the paper's estimator; `complete`: also manifold NEE through flat smooth boundaries (`manifold/`, docs/manifold.md) |
 //! | `reflection_chains` | boolean | with `connection = complete`: also connect through an internal reflection then a refraction (two-vertex chains, `manifold/chain.rs`, docs/manifold.md §9) under a directional light; default `false` (its cost exceeds its gain on the paper's statue) |
 //! | `snee_rate`  | float   | probability `r` of running SNEE at a scattering vertex (default: chosen per medium from its boundary and the lights, see [`snee::auto_rate`], revised under `connection = complete` by `snee::rate::complete_rates`); MIS counts SNEE's density as `r · pdf_snee`, so any `r` is unbiased |
-//! | `connection_rate` | float | with `connection = complete`: probability `q` in (0, 1] that the curved area-light connection (`manifold/curved_finite.rs`) runs at a medium vertex whose emitter sample picked an area light; default 0.05 (`curved_finite::RATE`, docs/manifold.md §8.2); part of its density, so any `q` is unbiased |
+//! | `connection_rate` | float | with `connection = complete`: the top rate `q_top` in (0, 1] of the curved area-light connection (`manifold/curved_finite.rs`): at a medium vertex `x_j` whose emitter sample picked an area light at `y` it runs with probability `q = q_top · max(e^{−σ_t t0}, 1e-3)`, `t0` the distance from `x_j` to the boundary towards `y`; default 0.05 (`curved_finite::RATE`, docs/manifold.md §8.2); part of its density, so any `q_top` is unbiased |
 //!
 //! ```xml
 //! <integrator type="volpath_snee">
