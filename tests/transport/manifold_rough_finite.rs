@@ -20,7 +20,7 @@ use crate::common;
 
 use common::{render_batches, scene};
 use snee::integrator::manifold::rough::{self, RoughPlane};
-use snee::integrator::manifold::{rough_finite, MediumVertex};
+use snee::integrator::manifold::{rough_finite, rough_rate, MediumVertex};
 use snee::integrator::snee::{SneeSuffix, SneeTechnique, SneeVertex};
 use snee::integrator::stats::LocalStats;
 use snee::interaction::{offset_origin, spawn_ray_between, DirectionSample};
@@ -164,8 +164,10 @@ fn connection_density_integrates_to_its_success_probability() {
                 successes += k;
                 successes2 += k * k;
             }
-            let p_success = successes as f64 / n_conn as f64;
-            let var_success = successes2 as f64 / n_conn as f64 - p_success * p_success;
+            // The connection runs at x_j with probability q (`rough_rate.rs`), part of p_man.
+            let q = rough_rate::rate_of(&s, 0);
+            let p_success = q * successes as f64 / n_conn as f64;
+            let var_success = q * q * (successes2 as f64 / n_conn as f64) - p_success * p_success;
             let se_success = (var_success.max(0.0) / n_conn as f64).sqrt();
             // Left: the density integrated by uniform directions and forward NEE at x_k.
             let n_int = 1usize << 21;
@@ -199,9 +201,9 @@ fn connection_density_integrates_to_its_success_probability() {
             let se = ((sum2 / n_int as f64 - mean * mean) / n_int as f64).sqrt();
             let z = (mean - p_success) / (se * se + se_success * se_success).sqrt();
             eprintln!(
-                "pebble {pebble} alpha {alpha} x_j {p_j}: ∫∫ p_man = {mean:.5} ± {se:.5}, success {p_success:.5} ± {se_success:.5}, z {z:+.2}"
+                "pebble {pebble} alpha {alpha} q {q} x_j {p_j}: ∫∫ p_man = {mean:.5} ± {se:.5}, success {p_success:.5} ± {se_success:.5}, z {z:+.2}"
             );
-            assert!(p_success > 0.05, "too few successes to test ({p_success})");
+            assert!(p_success > 0.05 * q, "too few successes to test ({p_success})");
             assert!(z.abs() < 4.0, "density does not integrate to the success probability: z = {z}");
         }
     }

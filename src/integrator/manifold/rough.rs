@@ -111,9 +111,11 @@ fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
         }
     }
     if curved {
-        return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true });
+        let q = super::rough_rate::rate(scene, medium);
+        return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true, q });
     }
-    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false })
+    let q = super::rough_rate::rate(scene, medium);
+    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false, q })
 }
 
 /// The rough boundary of `medium` (built with `connection = complete`).
@@ -210,6 +212,14 @@ pub fn sample(
     let u: Vec2 = sampler.next_2d();
     if v.depth.saturating_add(1) >= v.max_depth {
         return None;
+    }
+    // The rate q (`rough_rate.rs`): skip the connection at this vertex with probability 1 − q,
+    // consuming its numbers; its density is q · p_man at every place that weighs it.
+    if rb.q < 1.0 && sampler.next_1d() as f64 >= rb.q {
+        for _ in 0..rb.planes.len() + rb.curved as usize {
+            let _ = (sampler.next_1d(), sampler.next_2d());
+        }
+        return Some(Spectrum::ZERO);
     }
     stats.manifold_attempts += 1;
     let (ds, weight) = scene.sample_emitter_direction(v.p, None, u, false);

@@ -232,7 +232,7 @@ pub fn density(
     }
     let Some((r, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else { return 0.0 };
     let p_imp = rough_lobe::pdf_inner_ref(scene, &r, omega_ref, omega_jk);
-    combine(p_y, p_imp, si_k, end)
+    super::rough_rate::rate_of(scene, x_j.medium) * combine(p_y, p_imp, si_k, end)
 }
 
 /// SNEE's light record of the light end `end` seen from `x_k` (densities only): `p_light` is
@@ -323,7 +323,8 @@ pub fn connect(
         return fail(stats);
     }
     let p_imp = rough_lobe::pdf_inner_ref(scene, &reference, omega_ref, omega_jk);
-    let p_man = combine(p_y, p_imp, &si_k, &end);
+    // The caller ran the connection with probability q (`rough_rate.rs`).
+    let p_man = super::rough_rate::rate_of(scene, x_j.medium) * combine(p_y, p_imp, &si_k, &end);
     if !(p_man > 0.0) {
         return fail(stats);
     }

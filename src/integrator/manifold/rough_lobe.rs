@@ -300,7 +300,11 @@ pub fn rough_pdfs(
         fwd * bsdf.pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l)) as f64
     };
     let manifold = match reference {
-        Some(r) if !light.dist.is_finite() => light.p_light as f64 * pdf_inner_ref(scene, r, light.omega_l, omega_jk),
+        Some(r) if !light.dist.is_finite() => {
+            // The connection runs at x_j with probability q (`rough_rate.rs`).
+            let q = super::rough_rate::rate_of(scene, x_j.medium);
+            q * light.p_light as f64 * pdf_inner_ref(scene, r, light.omega_l, omega_jk)
+        }
         _ => 0.0,
     };
     let cos_k = omega_jk.dot(si_k.n).abs() as f64;

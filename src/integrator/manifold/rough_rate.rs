@@ -1,0 +1,40 @@
+//! The rate `q` of the rough-boundary connection (docs/manifold.md §7.2 "Rate"): the probability that
+//! the connection (`rough.rs`, `rough_finite.rs`) runs at a medium vertex behind a rough boundary.
+//!
+//! `q` is decided per medium when the tables are built, from scene quantities only (the medium's
+//! optical size, `snee::rate::optical_size`), and is a constant of the medium, so it is known at
+//! every place that evaluates the connection's density: that density is `q · p_man` everywhere
+//! (the connection divides its value by it, forward NEE, forward BSDF sampling and SNEE weigh
+//! against it), so the weights still sum to 1 and the combination stays unbiased for any
+//! `q ∈ (0, 1]`. Where the draw says "skip", the connection consumes its sample numbers and
+//! returns nothing.
+//!
+//! Why: in an optically thin medium most of the variance left is transport the connection does
+//! not make (internal reflection, glints: 73 % and 18 % at the statue's `sphere_ggx004_st02`),
+//! while each connection costs up to six rays (reference, trace, light segment, SNEE's support);
+//! running it at a fraction of the vertices keeps most of what it brings to single scattering and
+//! pays a fraction of the rays.
+
+use crate::integrator::snee::rate::{optical_size, THIN_OPTICAL_SIZE};
+use crate::scene::world::Scene;
+
+/// The rate in a medium whose optical size is below [`THIN_OPTICAL_SIZE`] (the size below which
+/// SNEE, too, stops running under `connection = complete`, `snee::rate::complete_rates`).
+pub const THIN_RATE: f64 = 0.25;
+
+/// The rate `q` of the connection through `medium`'s rough boundary: 1 where the medium is
+/// optically thick, [`THIN_RATE`] where it is thin ([`optical_size`] below [`THIN_OPTICAL_SIZE`]).
+pub fn rate(scene: &Scene, medium: u32) -> f64 {
+    if optical_size(scene, medium) < THIN_OPTICAL_SIZE {
+        THIN_RATE
+    } else {
+        1.0
+    }
+}
+
+/// The rate of the connection from a vertex in `medium` (1 where no rough boundary is built:
+/// then the densities that use it are 0 anyway).
+#[inline]
+pub fn rate_of(scene: &Scene, medium: u32) -> f64 {
+    super::rough::boundary_of(scene, medium).map_or(1.0, |rb| rb.q)
+}
