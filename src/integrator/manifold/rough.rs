@@ -254,14 +254,18 @@ pub fn sample(
         }
         let reference = match plane {
             Some(p) => Reference::of_plane(p),
-            None => match curved_reference(scene, x_j.medium, x_j.p, ds.d, stats) {
-                Some(r) => r,
+            // The depth factor of the rate (`rough_rate::depth_rate`) decided by u1 after x_0.
+            None => match super::rough_lobe::curved_reference_gated(scene, x_j.medium, x_j.p, ds.d, Some(u1), stats) {
+                Some(Some(r)) => r,
+                Some(None) => continue,
                 None => {
                     stats.manifold_failures += 1;
                     continue;
                 }
             },
         };
+        // u1 < q: rescaled, uniform again.
+        let u1 = super::rough_rate::rescale(u1, reference.q);
         let Some(c) = connect(scene, &x_j, &reference, plane, ds.d, u1, u2, stats) else { continue };
         let path = (&c.si_k, c.omega_jk, c.si_k.t);
         let p = rough_pdfs(scene, opts, x_i, &x_j, path, Some(&reference), &light, channel, true, stats);

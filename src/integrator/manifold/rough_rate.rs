@@ -38,3 +38,34 @@ pub fn rate(scene: &Scene, medium: u32) -> f64 {
 pub fn rate_of(scene: &Scene, medium: u32) -> f64 {
     super::rough::boundary_of(scene, medium).map_or(1.0, |rb| rb.q)
 }
+
+/// Optical depth from `x_j` to `x_0` (the boundary along the straight line towards the light)
+/// within which the connection always runs.
+pub const DEPTH_TAU: f64 = 3.0;
+/// Floor of [`depth_rate`].
+pub const DEPTH_MIN_RATE: f64 = 0.02;
+
+/// The depth factor of the rate at a vertex `x_j` of `medium` whose straight line towards the
+/// light meets the boundary at `x_0` after the distance `d_0` (curved boundaries;
+/// docs/manifold.md §7.2 "Rate"): with `tau = sigma_t,min · d_0`, 1 for `tau <= DEPTH_TAU`, else
+/// `exp(DEPTH_TAU − tau)`, at least [`DEPTH_MIN_RATE`]. The connection's value carries
+/// `exp(−sigma_t d_jk)` and `x_k` lands near `x_0`, so its expected contribution falls about as
+/// the rate; `f / p_man` then stays about `exp(−DEPTH_TAU)` times the value of a vertex at the
+/// surface. A function of `(x_j, light)` known at every place that evaluates the density
+/// (they all trace `x_0`).
+pub fn depth_rate(scene: &Scene, medium: u32, d_0: f32) -> f64 {
+    let tau = scene.media[medium as usize].sigma_t.min_element() as f64 * d_0 as f64;
+    if !(tau > DEPTH_TAU) {
+        return 1.0;
+    }
+    (DEPTH_TAU - tau).exp().max(DEPTH_MIN_RATE)
+}
+
+/// `u / q` for a uniform `u < q` (uniform on [0, 1) again), kept below 1.
+#[inline]
+pub fn rescale(u: f32, q: f64) -> f32 {
+    if q >= 1.0 {
+        return u;
+    }
+    ((u as f64 / q) as f32).min(1.0 - f32::EPSILON)
+}
