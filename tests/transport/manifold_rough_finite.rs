@@ -143,7 +143,8 @@ fn plane_of(scene: &Scene, si: &snee::interaction::SurfaceInteraction) -> Option
 fn connection_density_integrates_to_its_success_probability() {
     use snee::integrator::snee::light::light_transmission;
     // The last: the pebble at sigma_t = 20, where the rate's depth factor (`rough_rate::depth_rate`)
-    // is below 1 at these x_j (reported as q_depth).
+    // is below 1 at these x_j (reported as q_depth, for the pebble under the sphere light only:
+    // elsewhere the number printed is not the one the connection uses).
     for (pebble, alpha, light, sigma_t) in
         [(true, 0.3, SPHERE, 2), (false, 0.3, RECTANGLE, 2), (true, 0.2, RECTANGLE, 2), (true, 0.3, SPHERE, 20)]
     {

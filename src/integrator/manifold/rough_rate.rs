@@ -1,9 +1,12 @@
 //! The rate `q` of the rough-boundary connection (docs/manifold.md §7.2 "Rate"): the probability that
 //! the connection (`rough.rs`, `rough_finite.rs`) runs at a medium vertex behind a rough boundary.
 //!
-//! `q` is decided per medium when the tables are built, from scene quantities only (the medium's
-//! optical size, `snee::rate::optical_size`), and is a constant of the medium, so it is known at
-//! every place that evaluates the connection's density: that density is `q · p_man` everywhere
+//! `q` has two factors, both from scene quantities only: one per medium, decided when the tables
+//! are built from its optical size ([`rate`], `snee::rate::optical_size`), and on a curved
+//! boundary one per vertex, from the optical depth from `x_j` to `x_0`, the boundary point on the
+//! straight line towards the light ([`depth_rate`], decided after the reference's first ray and
+//! carried in `Reference::q`). Both are known at every place that evaluates the connection's
+//! density: that density is `q · p_man` everywhere
 //! (the connection divides its value by it, forward NEE, forward BSDF sampling and SNEE weigh
 //! against it), so the weights still sum to 1 and the combination stays unbiased for any
 //! `q ∈ (0, 1]`. Where the draw says "skip", the connection consumes its sample numbers and
