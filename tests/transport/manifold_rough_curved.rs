@@ -76,6 +76,22 @@ fn rough_pebble_under_sphere_light_agrees_with_volpath() {
     pebble_agrees_with_volpath(&ggx(0.2), sphere, "", 512, 140_000);
 }
 
+/// The depth factor of the connection's rate (`rough_rate::depth_rate`, docs/manifold.md §7.2
+/// "Rate") at work: the pebble at `sigma_t = 20` (optical size above the thin threshold, so the
+/// medium's rate is 1; vertices more than 0.15 from the boundary towards the light run the
+/// connection at a rate below 1). Counts as the other agreement tests, chosen before the first run.
+#[test]
+fn thick_rough_pebble_ggx020_directional_agrees_with_volpath() {
+    let xml = |integrator: &str, extra: &str| {
+        pebble(integrator, extra, &ggx(0.2), DIRECTIONAL)
+            .replace(r#"<float name="sigma_t" value="2"/>"#, r#"<float name="sigma_t" value="20"/>"#)
+    };
+    let volpath = render_batches(&scene(&xml("volpath", ""), &[]), 12, 512, 8, 150_000);
+    let mis = render_batches(&scene(&xml("volpath_snee", COMPLETE), &[]), 12, 128, 8, 150_100);
+    let fwd = render_batches(&scene(&xml("volpath_snee", COMPLETE_FORWARD), &[]), 12, 128, 8, 150_200);
+    common::assert_complete_agrees(&volpath, &mis, &fwd);
+}
+
 #[test]
 fn curved_rough_connection_runs() {
     use snee::render::{render, RenderOptions};

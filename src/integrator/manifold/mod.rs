@@ -49,6 +49,7 @@ pub mod planes;
 pub mod rough;
 pub mod rough_finite;
 pub mod rough_lobe;
+pub mod rough_rate;
 pub mod stage;
 pub mod track;
 

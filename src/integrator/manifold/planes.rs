@@ -64,6 +64,9 @@ pub struct RoughPlane {
 pub struct RoughBoundary {
     pub planes: Vec<RoughPlane>,
     pub curved: bool,
+    /// The rate `q` at which the connection runs at a medium vertex (`rough_rate::rate`,
+    /// docs/manifold.md §7.2 "Rate").
+    pub q: f64,
 }
 
 impl RoughBoundary {

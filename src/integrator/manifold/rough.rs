@@ -111,9 +111,11 @@ fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
         }
     }
     if curved {
-        return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true });
+        let q = super::rough_rate::rate(scene, medium);
+        return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true, q });
     }
-    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false })
+    let q = super::rough_rate::rate(scene, medium);
+    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false, q })
 }
 
 /// The rough boundary of `medium` (built with `connection = complete`).
@@ -211,6 +213,14 @@ pub fn sample(
     if v.depth.saturating_add(1) >= v.max_depth {
         return None;
     }
+    // The rate q (`rough_rate.rs`): skip the connection at this vertex with probability 1 − q,
+    // consuming its numbers; its density is q · p_man at every place that weighs it.
+    if rb.q < 1.0 && sampler.next_1d() as f64 >= rb.q {
+        for _ in 0..rb.planes.len() + rb.curved as usize {
+            let _ = (sampler.next_1d(), sampler.next_2d());
+        }
+        return Some(Spectrum::ZERO);
+    }
     stats.manifold_attempts += 1;
     let (ds, weight) = scene.sample_emitter_direction(v.p, None, u, false);
     // A directional light or the environment (infinitely far: omega_l is the same at every x_k).
@@ -244,14 +254,18 @@ pub fn sample(
         }
         let reference = match plane {
             Some(p) => Reference::of_plane(p),
-            None => match curved_reference(scene, x_j.medium, x_j.p, ds.d, stats) {
-                Some(r) => r,
+            // The depth factor of the rate (`rough_rate::depth_rate`) decided by u1 after x_0.
+            None => match super::rough_lobe::curved_reference_gated(scene, x_j.medium, x_j.p, ds.d, Some(u1), stats) {
+                Some(Some(r)) => r,
+                Some(None) => continue,
                 None => {
                     stats.manifold_failures += 1;
                     continue;
                 }
             },
         };
+        // u1 < q: rescaled, uniform again.
+        let u1 = super::rough_rate::rescale(u1, reference.q);
         let Some(c) = connect(scene, &x_j, &reference, plane, ds.d, u1, u2, stats) else { continue };
         let path = (&c.si_k, c.omega_jk, c.si_k.t);
         let p = rough_pdfs(scene, opts, x_i, &x_j, path, Some(&reference), &light, channel, true, stats);

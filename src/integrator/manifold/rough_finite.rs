@@ -159,6 +159,21 @@ pub fn point_reference(
     y: Vec3,
     stats: &mut LocalStats,
 ) -> Option<(Reference, Vec3)> {
+    point_reference_gated(scene, medium, plane, p_j, y, None, stats)?
+}
+
+/// [`point_reference`] with the connection's rate decided after the first ray (curved only, as
+/// `rough_lobe::curved_reference_gated`): `Some(None)` when `u_rate` is at or above the depth
+/// factor of `x_0`'s distance (the connection skips), `None` when there is no reference.
+pub fn point_reference_gated(
+    scene: &Scene,
+    medium: u32,
+    plane: Option<&RoughPlane>,
+    p_j: Vec3,
+    y: Vec3,
+    u_rate: Option<f32>,
+    stats: &mut LocalStats,
+) -> Option<Option<(Reference, Vec3)>> {
     let towards = |p: Vec3| (y - p).normalize();
     let omega_0 = towards(p_j);
     if !omega_0.is_finite() {
@@ -177,13 +192,17 @@ pub fn point_reference(
                     _ => break,
                 }
             }
-            Some((reference, omega))
+            Some(Some((reference, omega)))
         }
         None => {
             stats.rays += 1;
             let mut si = scene.ray_intersect(&Ray::new(p_j, omega_0))?;
             if !on_boundary(scene, &si, medium, omega_0) {
                 return None;
+            }
+            let q = super::rough_rate::depth_rate(scene, medium, si.t);
+            if u_rate.is_some_and(|u| u as f64 >= q) {
+                return Some(None);
             }
             for _ in 0..REFINE_STEPS {
                 let eta = eta_of(scene.bsdf(&si));
@@ -194,8 +213,8 @@ pub fn point_reference(
                     _ => break,
                 }
             }
-            let reference = Reference::of_point(scene, &si);
-            Some((reference, towards(si.p)))
+            let reference = Reference { q, ..Reference::of_point(scene, &si) };
+            Some(Some((reference, towards(si.p))))
         }
     }
 }
@@ -232,7 +251,7 @@ pub fn density(
     }
     let Some((r, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else { return 0.0 };
     let p_imp = rough_lobe::pdf_inner_ref(scene, &r, omega_ref, omega_jk);
-    combine(p_y, p_imp, si_k, end)
+    super::rough_rate::rate_of(scene, x_j.medium) * r.q * combine(p_y, p_imp, si_k, end)
 }
 
 /// SNEE's light record of the light end `end` seen from `x_k` (densities only): `p_light` is
@@ -305,9 +324,14 @@ pub fn connect(
     if !(p_y > 0.0) {
         return None;
     }
-    let Some((reference, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else {
-        return fail(stats);
+    // The depth factor of the rate (`rough_rate::depth_rate`) decided by u1 after x_0.
+    let (reference, omega_ref) = match point_reference_gated(scene, x_j.medium, plane, x_j.p, end.y, Some(u1), stats) {
+        Some(Some(r)) => r,
+        Some(None) => return None,
+        None => return fail(stats),
     };
+    // u1 < q: rescaled, uniform again.
+    let u1 = super::rough_rate::rescale(u1, reference.q);
     let omega_jk = rough_lobe::sample_inner_ref(scene, &reference, omega_ref, u1, u2)?;
     let Some(si_k) = rough_lobe::trace_inner(scene, x_j, plane, omega_jk, stats) else {
         return fail(stats);
@@ -323,7 +347,9 @@ pub fn connect(
         return fail(stats);
     }
     let p_imp = rough_lobe::pdf_inner_ref(scene, &reference, omega_ref, omega_jk);
-    let p_man = combine(p_y, p_imp, &si_k, &end);
+    // The caller ran the connection with probability q (`rough_rate.rs`).
+    let q = super::rough_rate::rate_of(scene, x_j.medium) * reference.q;
+    let p_man = q * combine(p_y, p_imp, &si_k, &end);
     if !(p_man > 0.0) {
         return fail(stats);
     }

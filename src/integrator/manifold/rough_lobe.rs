@@ -28,19 +28,22 @@ pub struct Reference {
     pub frame: Frame,
     pub bsdf: u32,
     pub wide: bool,
+    /// The depth factor of the connection's rate at this `x_j` (`rough_rate::depth_rate`; 1 on a
+    /// plane), a factor of `p_man` with the medium's rate.
+    pub q: f64,
 }
 
 impl Reference {
     /// The frame of a flat orientation (any tangent: the roughness is isotropic).
     #[inline]
     pub fn of_plane(plane: &RoughPlane) -> Self {
-        Reference { frame: Frame::from_normal(plane.n), bsdf: plane.bsdf, wide: false }
+        Reference { frame: Frame::from_normal(plane.n), bsdf: plane.bsdf, wide: false, q: 1.0 }
     }
 
     /// The shading frame and BSDF of the boundary point `si` of a curved boundary (`wide`).
     #[inline]
     pub fn of_point(scene: &Scene, si: &SurfaceInteraction) -> Self {
-        Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf, wide: true }
+        Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf, wide: true, q: 1.0 }
     }
 }
 
@@ -60,12 +63,31 @@ pub fn curved_reference(
     omega_l: Vec3,
     stats: &mut LocalStats,
 ) -> Option<Reference> {
+    curved_reference_gated(scene, medium, p_j, omega_l, None, stats)?
+}
+
+/// [`curved_reference`], with the connection's rate decided after the first ray: `u_rate`
+/// (uniform) at or above the depth factor `q` of `x_0`'s distance (`rough_rate::depth_rate`)
+/// returns `Some(None)` (the connection skips this vertex) before the refinement rays; `None`
+/// (never skip) for the places that only evaluate the density. `None`: no reference.
+pub fn curved_reference_gated(
+    scene: &Scene,
+    medium: u32,
+    p_j: Vec3,
+    omega_l: Vec3,
+    u_rate: Option<f32>,
+    stats: &mut LocalStats,
+) -> Option<Option<Reference>> {
     stats.rays += 1;
     let si0 = scene.ray_intersect(&Ray::new(p_j, omega_l))?;
     if !on_boundary(scene, &si0, medium, omega_l) {
         return None;
     }
-    let of = |si: &SurfaceInteraction| Reference::of_point(scene, si);
+    let q = super::rough_rate::depth_rate(scene, medium, si0.t);
+    if u_rate.is_some_and(|u| u as f64 >= q) {
+        return Some(None);
+    }
+    let of = |si: &SurfaceInteraction| Reference { q, ..Reference::of_point(scene, si) };
     let mut si = si0;
     for _ in 0..REFINE_STEPS {
         let Bsdf::RoughDielectric(b) = scene.bsdf(&si) else { break };
@@ -81,7 +103,7 @@ pub fn curved_reference(
             _ => break,
         }
     }
-    Some(of(&si))
+    Some(Some(of(&si)))
 }
 
 /// Refinement steps of [`curved_reference`] (each one ray at every evaluation of the density).
@@ -300,7 +322,11 @@ pub fn rough_pdfs(
         fwd * bsdf.pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l)) as f64
     };
     let manifold = match reference {
-        Some(r) if !light.dist.is_finite() => light.p_light as f64 * pdf_inner_ref(scene, r, light.omega_l, omega_jk),
+        Some(r) if !light.dist.is_finite() => {
+            // The connection runs at x_j with probability q (`rough_rate.rs`).
+            let q = super::rough_rate::rate_of(scene, x_j.medium) * r.q;
+            q * light.p_light as f64 * pdf_inner_ref(scene, r, light.omega_l, omega_jk)
+        }
         _ => 0.0,
     };
     let cos_k = omega_jk.dot(si_k.n).abs() as f64;
