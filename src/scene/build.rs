@@ -278,6 +278,12 @@ impl Builder<'_> {
             self.emitters.push(SceneEmitter::Area { shape: index, radiance });
             emitter = Some((self.emitters.len() - 1) as u32);
         }
+        if let Geometry::Sphere(s) = &mut geometry {
+            // Hits need the sphere's uv (acos, atan2) only when a texture of its BSDF or emitter reads it.
+            let radiance_uv = matches!(emitter.map(|e| &self.emitters[e as usize]),
+                Some(SceneEmitter::Area { radiance, .. }) if radiance.is_spatially_varying());
+            s.hit_uv = self.bsdfs[bsdf as usize].needs_uv() || radiance_uv;
+        }
         let sensor_desc = props.object_of(PluginKind::Sensor)?;
         props.finish()?;
         let shape =
