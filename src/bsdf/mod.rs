@@ -230,6 +230,33 @@ impl Bsdf {
         }
     }
 
+    /// Whether evaluating or sampling this model reads the hit's uv (a spatially varying texture
+    /// in it or in a nested model). Decided once at scene build, so that shapes whose uv costs
+    /// transcendentals (the sphere's acos / atan2) compute it only when it is read.
+    pub fn needs_uv(&self) -> bool {
+        let varying = |t: &Texture| t.is_spatially_varying();
+        let opt = |t: &Option<Texture>| t.as_ref().is_some_and(varying);
+        match self {
+            Bsdf::Diffuse(b) => varying(&b.reflectance),
+            Bsdf::Dielectric(b) => opt(&b.specular_reflectance) || opt(&b.specular_transmittance),
+            Bsdf::ThinDielectric(b) => opt(&b.specular_reflectance) || opt(&b.specular_transmittance),
+            Bsdf::RoughDielectric(b) => opt(&b.specular_reflectance) || opt(&b.specular_transmittance),
+            Bsdf::Null => false,
+            Bsdf::TwoSided(front, back) => front.needs_uv() || back.needs_uv(),
+            Bsdf::Conductor(b) => varying(&b.ior.eta) || varying(&b.ior.k) || opt(&b.specular_reflectance),
+            Bsdf::RoughConductor(b) => {
+                varying(&b.ior.eta)
+                    || varying(&b.ior.k)
+                    || varying(&b.alpha_u)
+                    || varying(&b.alpha_v)
+                    || opt(&b.specular_reflectance)
+            }
+            Bsdf::Plastic(b) => varying(&b.diffuse_reflectance) || opt(&b.specular_reflectance),
+            Bsdf::RoughPlastic(b) => varying(&b.diffuse_reflectance) || opt(&b.specular_reflectance),
+            Bsdf::Mask(b) => varying(&b.opacity) || b.nested.needs_uv(),
+        }
+    }
+
     /// Union of all component flags (Mitsuba's `BSDF::flags()`). Asked at every surface vertex:
     /// the leaf BSDFs have at most two lobes (and flags 0 past their last), so their union is
     /// that of lobes 0 and 1, without the loop: a constant per model (`flags_are_the_union_of_the_lobes`

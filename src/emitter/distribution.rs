@@ -76,7 +76,8 @@ impl Distribution1D {
         }
         let n = self.table.len();
         let x = u.clamp(0.0, 1.0) * n as f32;
-        let slot = (x as usize).min(n - 1);
+        // Through u32 (bins are indexed by u32): a cheaper saturating conversion, the same index.
+        let slot = (x as u32 as usize).min(n - 1);
         // Below 1, so a slot that keeps all of its bin (keep = 1) always keeps it.
         let frac = (x - slot as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
         let (keep, alias) = self.table[slot];

@@ -193,9 +193,10 @@ impl EnvironmentEmitter {
         let uv = Vec2::new(fract(uv.x - self.half_texel()), fract(uv.y));
         let x = uv.x * w as f32;
         let y = uv.y * (h - 1) as f32;
-        // Float → usize casts saturate (NaN → 0), so the indices stay in range.
-        let px = (x as usize).min(w - 1);
-        let py = (y as usize).min(h - 2);
+        // Float → integer casts saturate (NaN → 0), so the indices stay in range; through u32
+        // (a cheaper conversion than to usize, the same index: the map is narrower than 2^32).
+        let px = (x as u32 as usize).min(w - 1);
+        let py = (y as u32 as usize).min(h - 2);
         let (w1x, w1y) = (x - px as f32, y - py as f32);
         let (w0x, w0y) = (1.0 - w1x, 1.0 - w1y);
         let stride = w + 1;
@@ -228,7 +229,7 @@ impl EnvironmentEmitter {
         let u = uv.x - self.half_texel();
         let x = fract(u) * self.width as f32;
         let y = uv.y.clamp(0.0, 1.0) * (self.height - 1) as f32;
-        ((x as usize).min(self.width - 1), (y as usize).min(self.height - 2))
+        ((x as u32 as usize).min(self.width - 1), (y as u32 as usize).min(self.height - 2))
     }
 
     /// Sample a direction by luminance; weight = radiance / pdf (solid angle).

@@ -278,6 +278,15 @@ impl Builder<'_> {
             self.emitters.push(SceneEmitter::Area { shape: index, radiance });
             emitter = Some((self.emitters.len() - 1) as u32);
         }
+        // Hits need the uv (the sphere's: acos, atan2) only when a texture of the BSDF or emitter reads it.
+        let radiance_uv = matches!(emitter.map(|e| &self.emitters[e as usize]),
+            Some(SceneEmitter::Area { radiance, .. }) if radiance.is_spatially_varying());
+        let hit_uv = self.bsdfs[bsdf as usize].needs_uv() || radiance_uv;
+        match &mut geometry {
+            Geometry::Sphere(s) => s.hit_uv = hit_uv,
+            Geometry::Mesh(m) => m.skip_hit_uv = !hit_uv,
+            _ => {}
+        }
         let sensor_desc = props.object_of(PluginKind::Sensor)?;
         props.finish()?;
         let shape =

@@ -93,7 +93,7 @@ impl Scene {
             return (DirectionSample::default(), Spectrum::ZERO);
         }
         let x = sample.x * n as f32;
-        let index = (x as usize).min(n - 1);
+        let index = (x as u32 as usize).min(n - 1);
         let sample = Vec2::new(x - index as f32, sample.y);
         let (mut ds, mut weight) = self.sample_one_emitter(index, ref_p, sample);
         ds.emitter = index as u32;

@@ -62,6 +62,9 @@ pub struct Mesh {
     sample_triangles: Vec<SampleTriangle>,
     /// Triangles by area (alias table, for area sampling).
     area_distr: Distribution1D,
+    /// Set by the scene when neither the shape's BSDF nor its area emitter reads a spatially
+    /// varying texture: `interaction` then leaves uv zero instead of interpolating it.
+    pub skip_hit_uv: bool,
 }
 
 impl Mesh {
@@ -113,6 +116,7 @@ impl Mesh {
             face_frames: Vec::new(),
             sample_triangles: Vec::new(),
             area_distr,
+            skip_hit_uv: false,
         };
         mesh.face_frames = mesh.flat_frames();
         if mesh.indices.len() <= MAX_SAMPLE_TRIANGLES {
@@ -234,7 +238,9 @@ impl Mesh {
         let idx = self.indices[prim as usize];
         let (p, n) = self.point_and_normal(prim, b1, b2);
         let b0 = 1.0 - b1 - b2;
-        let uv = if self.uvs.is_empty() {
+        let uv = if self.skip_hit_uv {
+            Vec2::ZERO
+        } else if self.uvs.is_empty() {
             Vec2::new(b1, b2)
         } else {
             let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
@@ -357,4 +363,39 @@ pub fn from_file_props(
         _ => serialized::from_props(props, &path)?,
     };
     Ok(Geometry::Mesh(Mesh::new(data, to_world, face_normals, flip_normals)))
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::shape::Geometry;
+
+    #[test]
+    fn hit_uv_skipped_only_where_no_texture_reads_it() {
+        let xml = r#"<scene version="3.0.0">
+            <shape type="rectangle"><bsdf type="diffuse"><rgb name="reflectance" value="0.2"/></bsdf></shape>
+            <shape type="rectangle"><bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
+            <shape type="cube"><bsdf type="twosided"><bsdf type="roughconductor"/></bsdf></shape>
+            <shape type="rectangle"><emitter type="area"><texture type="checkerboard" name="radiance"/></emitter></shape>
+            <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor></scene>"#;
+        let parsed = crate::scene::xml::parse_str(xml, "t.xml", std::path::Path::new("."), &[]).expect("parses");
+        let scene = crate::scene::build::build_scene(&parsed).expect("builds");
+        let skip: Vec<bool> = scene
+            .shapes
+            .iter()
+            .filter_map(|s| match &s.geometry {
+                Geometry::Mesh(m) => Some(m.skip_hit_uv),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(skip, [true, false, true, false]);
+        // Skipping changes nothing but the uv.
+        let Geometry::Mesh(textured) = &scene.shapes[1].geometry else { panic!("a rectangle is a mesh") };
+        let plain = crate::shape::mesh::Mesh { skip_hit_uv: true, ..textured.clone() };
+        let d = glam::Vec3::new(0.1, -0.2, -1.0).normalize();
+        let (a, b) = (textured.interaction(1, 0.3, 0.25, 2.0, d), plain.interaction(1, 0.3, 0.25, 2.0, d));
+        assert_eq!(b.uv, glam::Vec2::ZERO);
+        assert_ne!(a.uv, glam::Vec2::ZERO);
+        assert_eq!((a.p, a.n, a.wi, a.t, a.prim), (b.p, b.n, b.wi, b.t, b.prim));
+        assert_eq!((a.sh_frame.s, a.sh_frame.t, a.sh_frame.n), (b.sh_frame.s, b.sh_frame.t, b.sh_frame.n));
+    }
 }

@@ -25,6 +25,9 @@ pub struct Sphere {
     /// Whether samples on the sphere need their uv: set by the scene when an area emitter with a
     /// textured radiance sits on it; otherwise sampling skips the acos / atan2.
     pub sample_uv: bool,
+    /// Whether hits need the sphere's uv: set by the scene when its BSDF or area emitter reads a
+    /// spatially varying texture; otherwise `interaction` leaves uv zero and skips the acos / atan2.
+    pub hit_uv: bool,
 }
 
 impl Sphere {
@@ -42,6 +45,7 @@ impl Sphere {
             to_world,
             to_object: to_world.inverse(),
             sample_uv: true,
+            hit_uv: true,
         }
     }
 
@@ -85,7 +89,7 @@ impl Sphere {
         // Re-project onto the surface to reduce error (as Mitsuba does).
         let p = self.center + n * self.radius;
         let local = self.to_object.transform_point3(p);
-        let uv = Self::local_uv(local);
+        let uv = if self.hit_uv { Self::local_uv(local) } else { Vec2::ZERO };
         // Mitsuba's dp/du = to_world (−y, x, 0) · 2π (zero at the poles: then coordinate_system(n)).
         let dp_du = self.to_world.transform_vector3(Vec3::new(-local.y, local.x, 0.0));
         if self.flip_normals {
@@ -238,6 +242,63 @@ impl Sphere {
 mod tests {
     use super::*;
     use crate::sampler::Sampler;
+
+    /// The spheres of a scene whose body is `shapes` (a 4×4 film).
+    fn spheres_of(shapes: &str) -> Vec<Sphere> {
+        let xml = format!(
+            r#"<scene version="3.0.0">{shapes}<sensor type="perspective"><film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor></scene>"#
+        );
+        let parsed = crate::scene::xml::parse_str(&xml, "t.xml", std::path::Path::new("."), &[]).expect("parses");
+        let scene = crate::scene::build::build_scene(&parsed).expect("builds");
+        scene
+            .shapes
+            .iter()
+            .filter_map(|s| match &s.geometry {
+                crate::shape::Geometry::Sphere(sp) => Some(sp.clone()),
+                _ => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn hit_uv_only_where_a_texture_reads_it() {
+        let checker = r#"<texture type="checkerboard" name="reflectance"/>"#;
+        let spheres = spheres_of(&format!(
+            r#"<shape type="sphere"><bsdf type="dielectric"/></shape>
+               <shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="0.2"/></bsdf></shape>
+               <shape type="sphere"><bsdf type="diffuse">{checker}</bsdf></shape>
+               <shape type="sphere"><bsdf type="twosided"><bsdf type="diffuse">{checker}</bsdf></bsdf></shape>
+               <shape type="sphere"><bsdf type="mask"><texture type="checkerboard" name="opacity"/><bsdf type="conductor"/></bsdf></shape>
+               <shape type="sphere"><emitter type="area"><texture type="checkerboard" name="radiance"/></emitter></shape>
+               <shape type="sphere"><emitter type="area"><rgb name="radiance" value="2"/></emitter></shape>"#
+        ));
+        let hit_uv: Vec<bool> = spheres.iter().map(|s| s.hit_uv).collect();
+        assert_eq!(hit_uv, [false, false, true, true, true, true, false]);
+    }
+
+    #[test]
+    fn interaction_without_uv_is_otherwise_the_same() {
+        let mut with_uv = Sphere::with_to_world(
+            Mat4::from_translation(Vec3::new(0.3, -0.2, 0.1))
+                * Mat4::from_rotation_x(0.7)
+                * Mat4::from_scale(Vec3::splat(1.5)),
+            false,
+        );
+        with_uv.hit_uv = true;
+        let without = Sphere { hit_uv: false, ..with_uv.clone() };
+        let mut sampler = Sampler::new(3, 0);
+        for _ in 0..1000 {
+            let o = Vec3::new(0.3, -0.2, 0.1) + warp::square_to_uniform_sphere(sampler.next_2d()) * 4.0;
+            let target = with_uv.center + warp::square_to_uniform_sphere(sampler.next_2d()) * 0.5;
+            let ray = Ray::new(o, (target - o).normalize());
+            let t = with_uv.intersect(&ray).expect("aimed inside the sphere");
+            let (a, b) = (with_uv.interaction(t, &ray), without.interaction(t, &ray));
+            assert_eq!(b.uv, Vec2::ZERO);
+            assert_eq!(a.uv, Sphere::local_uv(with_uv.to_object.transform_point3(a.p)));
+            assert_eq!((a.p, a.n, a.wi), (b.p, b.n, b.wi));
+            assert_eq!((a.sh_frame.s, a.sh_frame.t, a.sh_frame.n), (b.sh_frame.s, b.sh_frame.t, b.sh_frame.n));
+        }
+    }
 
     /// The double-precision textbook solution, as the reference.
     fn intersect_f64(s: &Sphere, ray: &Ray) -> Option<f64> {
