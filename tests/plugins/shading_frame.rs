@@ -7,6 +7,7 @@
 use crate::common;
 
 use snee::math::{Ray, Vec3};
+use snee::shape::Geometry;
 
 fn vec3(v: &serde_json::Value) -> Vec3 {
     let a = v.as_array().expect("array");
@@ -22,7 +23,15 @@ fn shading_frames_match_mitsuba() {
         let name = case["name"].as_str().unwrap();
         let xml =
             format!("<scene version=\"3.0.0\"><sensor type=\"perspective\"/>{}</scene>", case["xml"].as_str().unwrap());
-        let scene = common::scene(&xml, &[]);
+        let mut scene = common::scene(&xml, &[]);
+        // The loader computes uv on hits only where a texture reads it; here every hit's uv is checked.
+        for shape in &mut scene.shapes {
+            match &mut shape.geometry {
+                Geometry::Sphere(s) => s.hit_uv = true,
+                Geometry::Mesh(m) => m.skip_hit_uv = false,
+                Geometry::Disk(_) => {}
+            }
+        }
         for hit in case["hits"].as_array().unwrap() {
             let ray = Ray::new(vec3(&hit["o"]), vec3(&hit["d"]));
             let si = scene.ray_intersect(&ray).unwrap_or_else(|| panic!("{name}: no hit for {ray:?}"));
