@@ -105,19 +105,23 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         snee.rough = manifold::rough::rough_boundaries(scene);
         snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
         snee::rate::complete_rates(scene, &mut snee);
+        if snee.options.connection_rate.is_none() && manifold::curved_finite::off_when_thin(scene, &snee.curved) {
+            snee.options.connection_rate = Some(0.0);
+        }
         snee.meter_glint = manifold::meter_glint::build(scene);
     }
     snee.forward_only = forward_only(scene, &snee, connection);
     snee
 }
 
-/// Does nothing of `volpath_snee` run in `scene`? Then its loop would draw the same numbers and
-/// compute the same image as volpath's (bit for bit), only slower: it would still track every
-/// medium vertex and boundary crossing for MIS weights that all come out as volpath's. That holds
-/// when all transport is kept, SNEE never runs (`snee = forward`, or every medium's rate is 0 or
-/// SNEE does not apply), and with `connection = complete` no connection serves the scene: no flat
-/// or rough boundary, and curved boundaries lit only by environments (`envmap`, `constant`),
-/// which neither the curved connections nor the glints take (docs/manifold.md §8.2, §10).
+/// Does nothing of `volpath_snee` run in `scene`? Then its loop would compute volpath's estimate
+/// (every MIS weight comes out as volpath's; bit for bit where its stages draw no numbers), only
+/// slower: it would still track every medium vertex and boundary crossing. That holds when all
+/// transport is kept, SNEE never runs (`snee = forward`, or every medium's rate is 0 or SNEE does
+/// not apply), and with `connection = complete` no connection serves the scene: no flat or rough
+/// boundary, and curved boundaries lit only by emitters that no curved technique takes
+/// ([`curved_serves`]: environments, and area lights where the curved area-light connection is
+/// off, `curved_finite::off_when_thin`; docs/manifold.md §8.2, §10).
 pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool {
     let options = &snee.options;
     let no_snee = options.technique == SneeTechnique::Forward || snee.rates.iter().all(|r| r.is_none_or(|r| r == 0.0));
@@ -126,12 +130,19 @@ pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool 
         Connection::Complete => {
             snee.flat.iter().all(Option::is_none)
                 && snee.rough.iter().all(Option::is_none)
-                && (snee.curved.iter().all(|c| !c)
-                    || scene
-                        .emitters
-                        .iter()
-                        .all(|e| matches!(e, SceneEmitter::Other(Emitter::Envmap(_) | Emitter::Constant(_)))))
+                && (snee.curved.iter().all(|c| !c) || scene.emitters.iter().all(|e| !curved_serves(e, options)))
         }
     };
     options.keeps_all() && no_snee && no_connection && snee.meter_glint.is_none()
+}
+
+/// Can a technique through curved boundaries take emitter `e`? Directional lights (§8, chains,
+/// glints), area lights when the curved area-light connection runs (§8.2, top rate above 0), and,
+/// conservatively, point and spot lights; environments (`envmap`, `constant`) never.
+fn curved_serves(e: &SceneEmitter, options: &SneeOptions) -> bool {
+    match e {
+        SceneEmitter::Area { .. } => manifold::curved_finite::rate(*options) > 0.0,
+        SceneEmitter::Other(Emitter::Envmap(_) | Emitter::Constant(_)) => false,
+        SceneEmitter::Other(_) => true,
+    }
 }

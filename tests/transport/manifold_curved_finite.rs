@@ -23,8 +23,9 @@ const SPHERE: &str = r#"<shape type="sphere"><point name="center" x="-2" y="1" z
 
 // SNEE's rate given: by default SNEE does not run here (docs/snee.md §5), and this test checks
 // the three-way MIS with SNEE; `COMPLETE_FORWARD` covers the default (no SNEE).
-const COMPLETE: &str = r#"<string name="connection" value="complete"/><float name="snee_rate" value="0.25"/>"#;
-const COMPLETE_FORWARD: &str = r#"<string name="connection" value="complete"/><string name="snee" value="forward"/>"#;
+// The rate is given: these media are optically thin, where the connection is off by default.
+const COMPLETE: &str = r#"<string name="connection" value="complete"/><float name="snee_rate" value="0.25"/><float name="connection_rate" value="0.05"/>"#;
+const COMPLETE_FORWARD: &str = r#"<string name="connection" value="complete"/><string name="snee" value="forward"/><float name="connection_rate" value="0.05"/>"#;
 
 /// `medium_cube` with the cube replaced by a PLY mesh of `scenes/meshes`, emitters hidden.
 fn mesh(integrator: &str, extra: &str, bsdf: &str, file: &str) -> String {

@@ -140,8 +140,16 @@ fn forward_only_where_nothing_applies() {
     assert!(forward_only(&fwd));
     let (a, b) = (render_batches(&scene(&xml("volpath", ""), &[]), 2, 4, 8, 9100), render_batches(&fwd, 2, 4, 8, 9100));
     assert_eq!((a.stats, a.rays), (b.stats, b.rays));
+    // A sphere light through this thin medium: the curved area-light connection is off by default
+    // (`curved_finite::off_when_thin`), so nothing applies; with a rate given, or a thick medium
+    // (σt 3, optical size 6), it runs, and so does volpath_snee's loop.
+    assert!(forward_only(&scene(&smooth_sphere("volpath_snee", complete, SPHERE_LIGHT), &[])));
+    let rate = format!(r#"{complete}<float name="connection_rate" value="0.05"/>"#);
+    assert!(!forward_only(&scene(&smooth_sphere("volpath_snee", &rate, SPHERE_LIGHT), &[])));
+    let thick = smooth_sphere("volpath_snee", complete, SPHERE_LIGHT)
+        .replace(r#"<float name="sigma_t" value="1"/>"#, r#"<float name="sigma_t" value="3"/>"#);
+    assert!(!forward_only(&scene(&thick, &[])));
     // Techniques that apply keep volpath_snee's loop.
-    assert!(!forward_only(&scene(&smooth_sphere("volpath_snee", complete, SPHERE_LIGHT), &[])));
     assert!(!forward_only(&scene(&smooth_sphere("volpath_snee", "", SPHERE_LIGHT), &[])));
     assert!(!forward_only(&scene(&xml("volpath_snee", ""), &[])));
     let snee_only = r#"<string name="transport" value="snee"/><float name="snee_rate" value="0"/>"#;
