@@ -24,13 +24,17 @@ use super::manifold::{self, Connection};
 use super::snee::{self, Snee, SneeOptions, SneeTechnique, SneeTransport};
 use super::stats::LocalStats;
 use super::volpath;
+use crate::bsdf::Bsdf;
 use crate::color::Spectrum;
 use crate::emitter::Emitter;
-use crate::math::Ray;
+use crate::interaction::offset_origin;
+use crate::math::{Ray, Vec2};
 use crate::sampler::Sampler;
 use crate::scene::desc::Props;
 use crate::scene::world::{Scene, SceneEmitter};
 use crate::scene::Result;
+use crate::sensor::Camera;
+use manifold::meter_glint::MeterGlint;
 
 /// Radiance along a camera ray: volpath's loop with SNEE as one stage.
 pub fn li(
@@ -108,10 +112,35 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         if snee.options.connection_rate.is_none() && manifold::curved_finite::off_when_thin(scene, &snee.curved) {
             snee.options.connection_rate = Some(0.0);
         }
-        snee.meter_glint = manifold::meter_glint::build(scene);
+        snee.meter_glint = meter_glint(scene);
     }
     snee.forward_only = forward_only(scene, &snee, connection);
     snee
+}
+
+/// The irradiance meter's glint mixture (`manifold::meter_glint`, docs/manifold.md §11) for
+/// `scene`, or `None` where it does not apply: no meter, the probe ray from the centre of the
+/// meter's shape along its normal does not hit an isotropic `roughdielectric`, or no directional
+/// light is in front of that surface.
+fn meter_glint(scene: &Scene) -> Option<MeterGlint> {
+    let Camera::IrradianceMeter(meter) = &scene.camera else { return None };
+    let centre = meter.shape.sample_position(Vec2::splat(0.5));
+    let si = scene.ray_intersect(&Ray::new(offset_origin(centre.p, centre.n, centre.n), centre.n))?;
+    let bsdf = scene.bsdf(&si);
+    let Bsdf::RoughDielectric(r) = bsdf else { return None };
+    if r.alpha_u != r.alpha_v {
+        return None;
+    }
+    let n_ref = if si.n.dot(centre.n) < 0.0 { si.n } else { -si.n };
+    let wide_alpha = match manifold::rough_lobe::widened(bsdf) {
+        Some(Bsdf::RoughDielectric(w)) => Some(w.alpha_u),
+        _ => None,
+    };
+    let lights = scene.emitters.iter().filter_map(|e| match e {
+        SceneEmitter::Other(Emitter::Directional(d)) => Some(-d.d.normalize()),
+        _ => None,
+    });
+    MeterGlint::new(n_ref, r.distribution, r.alpha_u, wide_alpha, manifold::rough_lobe::WIDE_SHARE, lights)
 }
 
 /// Does nothing of `volpath_snee` run in `scene`? Then its loop would compute volpath's estimate

@@ -21,20 +21,16 @@
 //! where the glint is.
 //!
 //! The reference — the boundary the meter faces — is found once at scene load by a probe ray from
-//! the centre of the meter's shape along its normal; it applies when that ray hits a
-//! `roughdielectric` with an isotropic roughness, and there is at least one directional light.
+//! the centre of the meter's shape along its normal (`volpath_snee::build`); it applies when that
+//! ray hits a `roughdielectric` with an isotropic roughness, and there is at least one directional
+//! light in front of it.
 //! Elsewhere (and with `connection = paper`, and for every other integrator) the meter samples as
 //! Mitsuba does, bit for bit.
 
-use super::rough_lobe::{widened, WIDE_SHARE};
 use crate::bsdf::microfacet::{MicrofacetDistribution, MicrofacetType};
-use crate::bsdf::Bsdf;
-use crate::emitter::Emitter;
 use crate::interaction::offset_origin;
 use crate::math::{reflect, warp, Frame, Ray, Vec2, Vec3, INV_PI};
-use crate::scene::world::{Scene, SceneEmitter};
 use crate::sensor::irradiance_meter::IrradianceMeter;
-use crate::sensor::Camera;
 
 /// Probability of the meter's own cosine lobe in the mixture.
 pub const COSINE_SHARE: f32 = 0.5;
@@ -49,43 +45,39 @@ struct Lobe {
     wide: Option<MicrofacetDistribution>,
 }
 
-/// The meter's direction mixture, built once at scene load ([`build`]).
+/// The meter's direction mixture, built once at scene load (`volpath_snee::build` finds the
+/// reference with a probe ray and calls [`MeterGlint::new`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeterGlint {
     /// The boundary's normal towards the meter (`z` of the lobes' frame).
     n_ref: Vec3,
+    /// Share of the widened lobe within each light's part (`rough_lobe::WIDE_SHARE`).
+    wide_share: f32,
     lobes: Vec<Lobe>,
 }
 
-/// The mixture for `scene`'s irradiance meter, or `None` where it does not apply (no meter, no
-/// directional light, the probe from the meter's centre does not hit an isotropic
-/// `roughdielectric`).
-pub fn build(scene: &Scene) -> Option<MeterGlint> {
-    let Camera::IrradianceMeter(meter) = &scene.camera else { return None };
-    let centre = meter.shape.sample_position(Vec2::splat(0.5));
-    let ray = Ray::new(offset_origin(centre.p, centre.n, centre.n), centre.n);
-    let si = scene.ray_intersect(&ray)?;
-    let Bsdf::RoughDielectric(r) = scene.bsdf(&si) else { return None };
-    if r.alpha_u != r.alpha_v {
-        return None;
+impl MeterGlint {
+    /// The mixture about the reference normal `n_ref` (towards the meter) of a boundary with
+    /// microfacet distribution `kind` and roughness `alpha` (its widened roughness `wide_alpha`,
+    /// share `wide_share`), for the directional lights whose unit directions towards the light are
+    /// `lights`; `None` when no light is in front of the boundary.
+    pub fn new(
+        n_ref: Vec3,
+        kind: MicrofacetType,
+        alpha: f32,
+        wide_alpha: Option<f32>,
+        wide_share: f32,
+        lights: impl IntoIterator<Item = Vec3>,
+    ) -> Option<MeterGlint> {
+        let frame = Frame::from_normal(n_ref);
+        let wide = wide_alpha.map(|a| distribution(kind, a));
+        let lobes: Vec<Lobe> = lights
+            .into_iter()
+            .filter(|omega_l| omega_l.dot(n_ref) > 0.0)
+            .map(|omega_l| Lobe { omega_l: frame.to_local(omega_l), narrow: distribution(kind, alpha), wide })
+            .collect();
+        (!lobes.is_empty()).then_some(MeterGlint { n_ref, wide_share, lobes })
     }
-    let n_ref = if si.n.dot(centre.n) < 0.0 { si.n } else { -si.n };
-    let frame = Frame::from_normal(n_ref);
-    let wide = widened(scene.bsdf(&si)).map(|w| match w {
-        Bsdf::RoughDielectric(w) => distribution(r.distribution, w.alpha_u),
-        _ => unreachable!("widened returns a roughdielectric"),
-    });
-    let lobes: Vec<Lobe> = scene
-        .emitters
-        .iter()
-        .filter_map(|e| match e {
-            SceneEmitter::Other(Emitter::Directional(d)) => Some(-d.d.normalize()),
-            _ => None,
-        })
-        .filter(|omega_l| omega_l.dot(n_ref) > 0.0)
-        .map(|omega_l| Lobe { omega_l: frame.to_local(omega_l), narrow: distribution(r.distribution, r.alpha_u), wide })
-        .collect();
-    (!lobes.is_empty()).then_some(MeterGlint { n_ref, lobes })
 }
 
 /// `D(m) cos θ_m` sampling (not visible normals: the density must not depend on a direction
@@ -118,9 +110,10 @@ impl MeterGlint {
         let x = ((sample.x - c) / (1.0 - c)).min(below) * self.lobes.len() as f32;
         let lobe = &self.lobes[(x as usize).min(self.lobes.len() - 1)];
         let x = x.fract();
+        let w = self.wide_share;
         let (dist, x) = match &lobe.wide {
-            Some(wide) if x < WIDE_SHARE => (wide, (x / WIDE_SHARE).min(below)),
-            Some(_) => (&lobe.narrow, ((x - WIDE_SHARE) / (1.0 - WIDE_SHARE)).min(below)),
+            Some(wide) if x < w => (wide, (x / w).min(below)),
+            Some(_) => (&lobe.narrow, ((x - w) / (1.0 - w)).min(below)),
             None => (&lobe.narrow, x),
         };
         let (m, _) = dist.sample(Vec3::Z, Vec2::new(x, sample.y));
@@ -137,8 +130,8 @@ impl MeterGlint {
         for lobe in &self.lobes {
             let q = match &lobe.wide {
                 Some(wide) => {
-                    (1.0 - WIDE_SHARE) * lobe_pdf(&lobe.narrow, lobe.omega_l, omega_o)
-                        + WIDE_SHARE * lobe_pdf(wide, lobe.omega_l, omega_o)
+                    (1.0 - self.wide_share) * lobe_pdf(&lobe.narrow, lobe.omega_l, omega_o)
+                        + self.wide_share * lobe_pdf(wide, lobe.omega_l, omega_o)
                 }
                 None => lobe_pdf(&lobe.narrow, lobe.omega_l, omega_o),
             };

@@ -39,7 +39,7 @@ pub fn rate(scene: &Scene, medium: u32) -> f64 {
 /// then the densities that use it are 0 anyway).
 #[inline]
 pub fn rate_of(scene: &Scene, medium: u32) -> f64 {
-    super::rough::boundary_of(scene, medium).map_or(1.0, |rb| rb.q)
+    super::tables(scene).and_then(|t| t.rough.get(medium as usize)?.as_ref()).map_or(1.0, |rb| rb.q)
 }
 
 /// Optical depth from `x_j` to `x_0` (the boundary along the straight line towards the light)
