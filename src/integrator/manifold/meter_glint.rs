@@ -174,10 +174,8 @@ mod tests {
     use crate::testing::chi2::{chi2_sphere, sidak};
 
     fn glint(kind: MicrofacetType, alpha: f32, lights: &[Vec3]) -> MeterGlint {
-        let wide = Some(distribution(kind, (alpha * 8.0).min(0.5)));
-        let lobes =
-            lights.iter().map(|l| Lobe { omega_l: l.normalize(), narrow: distribution(kind, alpha), wide }).collect();
-        MeterGlint { n_ref: Vec3::Z, lobes }
+        let wide = Some((alpha * 8.0).min(0.5));
+        MeterGlint::new(Vec3::Z, kind, alpha, wide, 0.5, lights.iter().map(|l| l.normalize())).unwrap()
     }
 
     /// The mixture's sampler against its density (chi-square over the sphere), for a meter facing
