@@ -148,7 +148,8 @@ fn meter_glint(scene: &Scene) -> Option<MeterGlint> {
 /// slower: it would still track every medium vertex and boundary crossing. That holds when all
 /// transport is kept, SNEE never runs (`snee = forward`, or every medium's rate is 0 or SNEE does
 /// not apply), and with `connection = complete` no connection serves the scene: no flat or rough
-/// boundary, and curved boundaries lit only by emitters that no curved technique takes
+/// boundary, no directional light (the camera's glints), and curved boundaries lit only by
+/// emitters that no curved technique takes
 /// ([`curved_serves`]: environments, and area lights where the curved area-light connection is
 /// off, `curved_finite::off_when_thin`; docs/manifold.md §8.2, §10).
 pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool {
@@ -157,8 +158,12 @@ pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool 
     let no_connection = match connection {
         Connection::Paper => true,
         Connection::Complete => {
+            let directional = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_))));
             snee.flat.iter().all(Option::is_none)
                 && snee.rough.iter().all(Option::is_none)
+                // The camera's glints (`manifold::glint`) take directional lights on any medium's
+                // smooth boundary, whether or not the curved connection serves that medium.
+                && !directional
                 && (snee.curved.iter().all(|c| !c) || scene.emitters.iter().all(|e| !curved_serves(e, options)))
         }
     };

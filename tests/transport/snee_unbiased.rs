@@ -149,6 +149,14 @@ fn forward_only_where_nothing_applies() {
     let thick = smooth_sphere("volpath_snee", complete, SPHERE_LIGHT)
         .replace(r#"<float name="sigma_t" value="1"/>"#, r#"<float name="sigma_t" value="3"/>"#);
     assert!(!forward_only(&scene(&thick, &[])));
+    // A directional light: the camera's glints run on the glass even where the medium does not
+    // sample emitters (no SNEE, no connection).
+    let sun = r#"<emitter type="directional"><vector name="direction" value="0, -1, -1"/></emitter>"#;
+    let quiet = smooth_sphere("volpath_snee", complete, sun).replace(
+        r#"<float name="sigma_t" value="1"/>"#,
+        r#"<float name="sigma_t" value="1"/><boolean name="sample_emitters" value="false"/>"#,
+    );
+    assert!(!forward_only(&scene(&quiet, &[])));
     // Techniques that apply keep volpath_snee's loop.
     assert!(!forward_only(&scene(&smooth_sphere("volpath_snee", "", SPHERE_LIGHT), &[])));
     assert!(!forward_only(&scene(&xml("volpath_snee", ""), &[])));
