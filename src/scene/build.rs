@@ -282,11 +282,7 @@ impl Builder<'_> {
         let radiance_uv = matches!(emitter.map(|e| &self.emitters[e as usize]),
             Some(SceneEmitter::Area { radiance, .. }) if radiance.is_spatially_varying());
         let hit_uv = self.bsdfs[bsdf as usize].needs_uv() || radiance_uv;
-        match &mut geometry {
-            Geometry::Sphere(s) => s.hit_uv = hit_uv,
-            Geometry::Mesh(m) => m.skip_hit_uv = !hit_uv,
-            _ => {}
-        }
+        geometry.set_hit_uv(hit_uv);
         let sensor_desc = props.object_of(PluginKind::Sensor)?;
         props.finish()?;
         let shape =

@@ -62,9 +62,10 @@ pub struct Mesh {
     sample_triangles: Vec<SampleTriangle>,
     /// Triangles by area (alias table, for area sampling).
     area_distr: Distribution1D,
-    /// Set by the scene when neither the shape's BSDF nor its area emitter reads a spatially
-    /// varying texture: `interaction` then leaves uv zero instead of interpolating it.
-    pub skip_hit_uv: bool,
+    /// Whether hits need their uv: cleared by the scene when neither the shape's BSDF nor its area
+    /// emitter reads a spatially varying texture; `interaction` then leaves uv zero instead of
+    /// interpolating it.
+    pub hit_uv: bool,
 }
 
 impl Mesh {
@@ -116,7 +117,7 @@ impl Mesh {
             face_frames: Vec::new(),
             sample_triangles: Vec::new(),
             area_distr,
-            skip_hit_uv: false,
+            hit_uv: true,
         };
         mesh.face_frames = mesh.flat_frames();
         if mesh.indices.len() <= MAX_SAMPLE_TRIANGLES {
@@ -238,7 +239,7 @@ impl Mesh {
         let idx = self.indices[prim as usize];
         let (p, n) = self.point_and_normal(prim, b1, b2);
         let b0 = 1.0 - b1 - b2;
-        let uv = if self.skip_hit_uv {
+        let uv = if !self.hit_uv {
             Vec2::ZERO
         } else if self.uvs.is_empty() {
             Vec2::new(b1, b2)
@@ -383,14 +384,14 @@ mod tests {
             .shapes
             .iter()
             .filter_map(|s| match &s.geometry {
-                Geometry::Mesh(m) => Some(m.skip_hit_uv),
+                Geometry::Mesh(m) => Some(!m.hit_uv),
                 _ => None,
             })
             .collect();
         assert_eq!(skip, [true, false, true, false]);
         // Skipping changes nothing but the uv.
         let Geometry::Mesh(textured) = &scene.shapes[1].geometry else { panic!("a rectangle is a mesh") };
-        let plain = crate::shape::mesh::Mesh { skip_hit_uv: true, ..textured.clone() };
+        let plain = crate::shape::mesh::Mesh { hit_uv: false, ..textured.clone() };
         let d = glam::Vec3::new(0.1, -0.2, -1.0).normalize();
         let (a, b) = (textured.interaction(1, 0.3, 0.25, 2.0, d), plain.interaction(1, 0.3, 0.25, 2.0, d));
         assert_eq!(b.uv, glam::Vec2::ZERO);

@@ -33,6 +33,16 @@ pub enum Geometry {
 pub const SUPPORTED_SHAPES: &str = "obj, ply, serialized, rectangle, cube, sphere, disk";
 
 impl Geometry {
+    /// Whether hits compute their uv (the scene clears it where no texture reads it). Spheres and
+    /// meshes honour it; a disk always computes its uv.
+    pub fn set_hit_uv(&mut self, on: bool) {
+        match self {
+            Geometry::Sphere(s) => s.hit_uv = on,
+            Geometry::Mesh(m) => m.hit_uv = on,
+            Geometry::Disk(_) => {}
+        }
+    }
+
     /// The geometry of a `<shape>`: the parameters every shape has (`to_world`, `flip_normals`),
     /// then the plugin's own, read by its file (`rectangle.rs`, `cube.rs`, `sphere.rs`, ...).
     /// The BSDF, emitter and media of the shape are the scene builder's.

@@ -7,7 +7,6 @@
 use crate::common;
 
 use snee::math::{Ray, Vec3};
-use snee::shape::Geometry;
 
 fn vec3(v: &serde_json::Value) -> Vec3 {
     let a = v.as_array().expect("array");
@@ -26,11 +25,7 @@ fn shading_frames_match_mitsuba() {
         let mut scene = common::scene(&xml, &[]);
         // The loader computes uv on hits only where a texture reads it; here every hit's uv is checked.
         for shape in &mut scene.shapes {
-            match &mut shape.geometry {
-                Geometry::Sphere(s) => s.hit_uv = true,
-                Geometry::Mesh(m) => m.skip_hit_uv = false,
-                Geometry::Disk(_) => {}
-            }
+            shape.geometry.set_hit_uv(true);
         }
         for hit in case["hits"].as_array().unwrap() {
             let ray = Ray::new(vec3(&hit["o"]), vec3(&hit["d"]));

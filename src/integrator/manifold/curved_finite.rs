@@ -47,16 +47,15 @@ pub const RATE: f64 = 0.05;
 pub const MIN_DEPTH_FACTOR: f64 = 1e-3;
 
 /// Does the connection stay off by default in `scene` (top rate 0, when `connection_rate` is not
-/// given)? When every medium it serves (`curved`, per medium) is optically thin:
-/// `snee::rate::optical_size` below `THIN_OPTICAL_SIZE`, the size below which SNEE stops running
-/// under `complete` too. There it has not paid for its cost: `sphere_smooth_st02` (optical size
+/// given)? When every medium it serves (`curved`, per medium) is optically thin
+/// (`snee::rate::optically_thin`, where SNEE stops running under `complete` too). There it has not paid for its cost: `sphere_smooth_st02` (optical size
 /// 0.86) read 0.77–0.90× `volpath`'s equal-time efficiency in four measurements at rates 0.05–0.1
 /// (docs/manifold.md §8.2); with the connection off and SNEE's rate 0, `volpath_snee` runs
 /// volpath's loop there (`volpath_snee::forward_only`).
 pub fn off_when_thin(scene: &Scene, curved: &[bool]) -> bool {
-    use crate::integrator::snee::rate::{optical_size, THIN_OPTICAL_SIZE};
-    let served: Vec<u32> = (0..curved.len() as u32).filter(|&m| curved[m as usize]).collect();
-    !served.is_empty() && served.iter().all(|&m| optical_size(scene, m) < THIN_OPTICAL_SIZE)
+    use crate::integrator::snee::rate::optically_thin;
+    let mut served = (0u32..).zip(curved).filter(|(_, &c)| c).map(|(m, _)| m).peekable();
+    served.peek().is_some() && served.all(|m| optically_thin(scene, m))
 }
 
 /// The connection's top rate under `opts`: `connection_rate`, else [`RATE`] (`volpath_snee::build`

@@ -93,18 +93,15 @@ pub fn geometry_term(patch: &Patch, x_j: DVec3, omega: DVec3, y: DVec3, o: DVec3
 /// shading normal at the hit `x_k⁰` and reverse it (`None` also when `y` is behind that normal).
 pub fn seed_line(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> (Option<f64>, Option<DVec3>) {
     let d0 = (y - x_j).normalize();
-    let Some((t0, x_k0, n_s, eta)) =
-        locate.locate(x_j, d0).and_then(|p| Some((p.hit(x_j, d0)?, p.eta))).map(|((t, x, n), eta)| (t, x, n, eta))
-    else {
-        return (None, None);
-    };
+    let Some(patch) = locate.locate(x_j, d0) else { return (None, None) };
+    let Some((t0, x_k0, n_s)) = patch.hit(x_j, d0) else { return (None, None) };
     let omega_l = (y - x_k0).normalize();
     let cos_l = omega_l.dot(n_s);
     if !(cos_l > 0.0) {
         return (Some(t0), None);
     }
     // η_ext sin θ_l = η_int sin θ_in: the tangential part shrinks by 1/η.
-    let tangential = (omega_l - n_s * cos_l) / eta;
+    let tangential = (omega_l - n_s * cos_l) / patch.eta;
     let cos_in = (1.0 - tangential.length_squared()).max(0.0).sqrt();
     (Some(t0), Some((tangential + n_s * cos_in).normalize()))
 }

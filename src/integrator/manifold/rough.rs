@@ -110,11 +110,10 @@ fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
             }
         }
     }
+    let q = super::rough_rate::rate(scene, medium);
     if curved {
-        let q = super::rough_rate::rate(scene, medium);
         return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true, q });
     }
-    let q = super::rough_rate::rate(scene, medium);
     (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false, q })
 }
 

@@ -251,7 +251,7 @@ pub fn density(
     }
     let Some((r, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else { return 0.0 };
     let p_imp = rough_lobe::pdf_inner_ref(scene, &r, omega_ref, omega_jk);
-    super::rough_rate::rate_of(scene, x_j.medium) * r.q * combine(p_y, p_imp, si_k, end)
+    super::rough_rate::of_vertex(scene, x_j.medium, r.q) * combine(p_y, p_imp, si_k, end)
 }
 
 /// SNEE's light record of the light end `end` seen from `x_k` (densities only): `p_light` is
@@ -348,7 +348,7 @@ pub fn connect(
     }
     let p_imp = rough_lobe::pdf_inner_ref(scene, &reference, omega_ref, omega_jk);
     // The caller ran the connection with probability q (`rough_rate.rs`).
-    let q = super::rough_rate::rate_of(scene, x_j.medium) * reference.q;
+    let q = super::rough_rate::of_vertex(scene, x_j.medium, reference.q);
     let p_man = q * combine(p_y, p_imp, &si_k, &end);
     if !(p_man > 0.0) {
         return fail(stats);

@@ -324,7 +324,7 @@ pub fn rough_pdfs(
     let manifold = match reference {
         Some(r) if !light.dist.is_finite() => {
             // The connection runs at x_j with probability q (`rough_rate.rs`).
-            let q = super::rough_rate::rate_of(scene, x_j.medium) * r.q;
+            let q = super::rough_rate::of_vertex(scene, x_j.medium, r.q);
             q * light.p_light as f64 * pdf_inner_ref(scene, r, light.omega_l, omega_jk)
         }
         _ => 0.0,

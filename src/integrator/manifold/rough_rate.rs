@@ -18,17 +18,17 @@
 //! running it at a fraction of the vertices keeps most of what it brings to single scattering and
 //! pays a fraction of the rays.
 
-use crate::integrator::snee::rate::{optical_size, THIN_OPTICAL_SIZE};
+use crate::integrator::snee::rate::optically_thin;
 use crate::scene::world::Scene;
 
-/// The rate in a medium whose optical size is below [`THIN_OPTICAL_SIZE`] (the size below which
-/// SNEE, too, stops running under `connection = complete`, `snee::rate::complete_rates`).
+/// The rate in an optically thin medium (`snee::rate::optically_thin`: where SNEE, too, stops
+/// running under `connection = complete`, `snee::rate::complete_rates`).
 pub const THIN_RATE: f64 = 0.25;
 
 /// The rate `q` of the connection through `medium`'s rough boundary: 1 where the medium is
-/// optically thick, [`THIN_RATE`] where it is thin ([`optical_size`] below [`THIN_OPTICAL_SIZE`]).
+/// optically thick, [`THIN_RATE`] where it is thin (`snee::rate::optically_thin`).
 pub fn rate(scene: &Scene, medium: u32) -> f64 {
-    if optical_size(scene, medium) < THIN_OPTICAL_SIZE {
+    if optically_thin(scene, medium) {
         THIN_RATE
     } else {
         1.0
@@ -40,6 +40,14 @@ pub fn rate(scene: &Scene, medium: u32) -> f64 {
 #[inline]
 pub fn rate_of(scene: &Scene, medium: u32) -> f64 {
     super::tables(scene).and_then(|t| t.rough.get(medium as usize)?.as_ref()).map_or(1.0, |rb| rb.q)
+}
+
+/// The whole rate `q` of the connection from a vertex in `medium` whose reference carries the depth
+/// factor `depth` (`Reference::q`): the medium's rate ([`rate_of`]) times it. The factor of `p_man`
+/// at every place that evaluates the connection's density.
+#[inline]
+pub fn of_vertex(scene: &Scene, medium: u32, depth: f64) -> f64 {
+    rate_of(scene, medium) * depth
 }
 
 /// Optical depth from `x_j` to `x_0` (the boundary along the straight line towards the light)

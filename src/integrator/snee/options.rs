@@ -77,8 +77,8 @@ pub struct Snee {
     /// Per medium: does the curved connection apply (`manifold::curved::curved_boundaries`)?
     pub curved: Vec<bool>,
     /// Nothing of `volpath_snee` runs in this scene (no SNEE rate above 0, no manifold connection
-    /// or glint that serves its emitters, all transport kept): `li` is then volpath's loop,
-    /// bit for bit (`volpath_snee::forward_only`, docs/snee.md §5).
+    /// or glint that serves its emitters, all transport kept): `li` is then volpath's loop, whose
+    /// estimate `volpath_snee`'s would equal (`volpath_snee::forward_only`, docs/snee.md §5).
     pub forward_only: bool,
     /// With `connection = complete`: the irradiance meter's direction mixture towards the glints
     /// of directional lights on the rough boundary it faces (`manifold::meter_glint`).

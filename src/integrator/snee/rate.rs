@@ -81,6 +81,12 @@ pub const AUTO_RATE_COMPLETE_AREA: f32 = 0.0;
 /// after two medium vertices and SNEE's samples cost more than they bring.
 pub const THIN_OPTICAL_SIZE: f32 = 4.0;
 
+/// Is `medium` optically thin ([`optical_size`] below [`THIN_OPTICAL_SIZE`])? Where SNEE, the rough
+/// connection's full rate and the curved area-light connection give way under `complete`.
+pub fn optically_thin(scene: &Scene, medium: u32) -> bool {
+    optical_size(scene, medium) < THIN_OPTICAL_SIZE
+}
+
 /// The optical size of `medium`: its smallest extinction coefficient (over channels) times the
 /// shortest side of the bounding box of the shapes that enclose it.
 pub fn optical_size(scene: &Scene, medium: u32) -> f32 {
@@ -120,7 +126,7 @@ pub fn complete_rates(scene: &Scene, snee: &mut Snee) {
         }
         if area_only && snee.curved.get(m).copied().unwrap_or(false) {
             *rate = Some(AUTO_RATE_COMPLETE_AREA);
-        } else if optical_size(scene, m as u32) < THIN_OPTICAL_SIZE {
+        } else if optically_thin(scene, m as u32) {
             *rate = Some(0.0);
         }
     }
