@@ -69,7 +69,9 @@ impl TraceRay {
     pub fn new(o: Vec3, d: Vec3) -> TraceRay {
         let d0 = Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO;
         let inv = Vec4::ONE / d0;
-        TraceRay { node: NodeRay::with_inverse(o, d0, inv), wt: WatertightRay::with_inverse(o, d, inv) }
+        let node = NodeRay::with_inverse(o, d0, inv);
+        let neg = d0.cmplt(Vec4::ZERO).bitmask() & 7;
+        TraceRay { node, wt: WatertightRay::with_inverse_octant(o, d, inv, neg) }
     }
 }
 
