@@ -67,8 +67,9 @@ pub struct WatertightRay {
     k: [usize; 3],
     /// Shear (sx, sy, sz), splatted.
     s: [Vec4; 3],
-    /// Ray origin in the permuted axes, splatted.
-    o: [Vec4; 3],
+    /// Minus the ray origin in the permuted axes, splatted (`v + (−o)` is `v − o` bit for bit, and
+    /// takes the vertex row as a memory operand).
+    neg_o: [Vec4; 3],
 }
 
 /// The edge functions recomputed in `f64` (Woop et al. 2013, Sec. 3.3) in the lanes of `lanes`,
@@ -88,12 +89,12 @@ fn edges_f64(lanes: u32, p: [Vec4; 6], uvw: [Vec4; 3]) -> (Vec4, Vec4, Vec4) {
 #[inline(always)]
 fn sheared(w: &WatertightRay, p: &TriPacket4, j: usize) -> (Vec4, Vec4, Vec4) {
     let v = &p.v[j];
-    // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse`),
+    // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse_octant`),
     // so the four floats from each offset are one row of `v`.
     let row = |k: usize| unsafe { Vec4::from_array(*v.as_ptr().cast::<f32>().add(k).cast::<[f32; 4]>()) };
-    let rx = row(w.k[0]) - w.o[0];
-    let ry = row(w.k[1]) - w.o[1];
-    let rz = row(w.k[2]) - w.o[2];
+    let rx = row(w.k[0]) + w.neg_o[0];
+    let ry = row(w.k[1]) + w.neg_o[1];
+    let rz = row(w.k[2]) + w.neg_o[2];
     (rx - w.s[0] * rz, ry - w.s[1] * rz, w.s[2] * rz)
 }
 
@@ -101,23 +102,23 @@ impl WatertightRay {
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         let d0 = Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO;
-        Self::with_inverse(o, d, Vec4::ONE / d0)
+        Self::with_inverse(-o, d, Vec4::ONE / d0)
     }
 
     /// The test's state from axes `k` and shear `s` as [`shear_axes`] gives them.
     pub fn from_parts(k: [usize; 3], s: [f32; 3], o: Vec3) -> Self {
         assert!(k.iter().all(|&a| a < 3), "axes {k:?}");
-        WatertightRay { k: k.map(|a| 4 * a), s: s.map(Vec4::splat), o: k.map(|a| Vec4::splat(o[a])) }
+        WatertightRay { k: k.map(|a| 4 * a), s: s.map(Vec4::splat), neg_o: k.map(|a| Vec4::splat(-o[a])) }
     }
 
-    /// [`WatertightRay::new`] given `inv` = 1 / (d + 0) per axis (the node test's unclamped inverse,
+    /// [`WatertightRay::new`] given `neg_o` = −o and `inv` = 1 / (d + 0) per axis (the node test's unclamped inverse,
     /// so that one division serves both): the axes of [`shear_axes`] chosen without branches, and
     /// `sz` read from `inv` (the same division; it differs from `1 / d[kz]` only in the sign of an
     /// infinity when `d` is zero, where every lane is NaN and misses either way).
     #[inline(always)]
-    pub fn with_inverse(o: Vec3, d: Vec3, inv: Vec4) -> Self {
+    pub fn with_inverse(neg_o: Vec3, d: Vec3, inv: Vec4) -> Self {
         let neg = (d + Vec3::ZERO).cmplt(Vec3::ZERO).bitmask();
-        Self::with_inverse_octant(o, d, inv, neg)
+        Self::with_inverse_octant(neg_o, d, inv, neg)
     }
 
     /// [`WatertightRay::with_inverse`] given also `neg`, the sign bits of `d + 0` (bit `a` set when
@@ -125,13 +126,13 @@ impl WatertightRay {
     /// `kz` and the sign of `d[kz]` (a zero `d[kz]`, i.e. `d` zero, counts as positive, as
     /// `d[kz] < 0.0` does for ±0).
     #[inline(always)]
-    pub fn with_inverse_octant(o: Vec3, d: Vec3, inv: Vec4, neg: u32) -> Self {
+    pub fn with_inverse_octant(neg_o: Vec3, d: Vec3, inv: Vec4, neg: u32) -> Self {
         let a = d.abs();
         let (xy, xz, yz) = ((a.x > a.y) as usize, (a.x > a.z) as usize, (a.y > a.z) as usize);
         // shear_axes: a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2).
         let kz = if xy != 0 { 2 - 2 * xz } else { 2 - yz };
         let [kx, ky] = AXES[2 * kz + ((neg >> kz) & 1) as usize].map(usize::from);
-        let (d, o, inv) = (d.to_array(), o.to_array(), inv.to_array());
+        let (d, o, inv) = (d.to_array(), neg_o.to_array(), inv.to_array());
         // SAFETY: `kx`, `ky` (rows of `AXES`) and `kz` are below 3.
         let (dx, dy, ox, oy, oz, sz) = unsafe {
             (
@@ -146,7 +147,7 @@ impl WatertightRay {
         WatertightRay {
             k: [4 * kx, 4 * ky, 4 * kz],
             s: [Vec4::splat(dx * sz), Vec4::splat(dy * sz), Vec4::splat(*sz)],
-            o: [Vec4::splat(*ox), Vec4::splat(*oy), Vec4::splat(*oz)],
+            neg_o: [Vec4::splat(*ox), Vec4::splat(*oy), Vec4::splat(*oz)],
         }
     }
 
