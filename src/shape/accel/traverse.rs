@@ -20,7 +20,10 @@ const FAR_SCALE: f32 = 1.000_000_4;
 /// The ray as the node test needs it.
 #[derive(Clone, Copy, Debug)]
 pub struct NodeRay {
-    pub o: [f32; 3],
+    /// −o: the slab test computes `b + (−o)`, which equals `b − o` bit for bit (IEEE negation is
+    /// exact, and `x + (−y)` rounds as `x − y`) but lets the box row be read as a memory operand
+    /// of the addition (a subtraction only takes the subtrahend from memory).
+    pub neg_o: [f32; 3],
     pub inv_d: [f32; 3],
     /// Where the row of `Node8::bounds` holding the near (entry) plane per axis starts in the
     /// bounds read as one array of 48 floats (8 × row; [`Node8::row`]), and the far one's: an offset
@@ -34,21 +37,21 @@ impl NodeRay {
     pub fn new(o: Vec3, d: Vec3) -> NodeRay {
         // −0.0 → +0.0, so that the sign test and the inverse agree.
         let d0 = Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO;
-        Self::with_inverse(o, d0, Vec4::ONE / d0)
+        Self::with_inverse(-o, d0, Vec4::ONE / d0)
     }
 
-    /// From `d0` = d + 0 (w lane 1) and its inverse `inv` = 1 / d0: a non-finite inverse (zero
+    /// From `neg_o` = −o, `d0` = d + 0 (w lane 1) and its inverse `inv` = 1 / d0: a non-finite inverse (zero
     /// component) becomes ±`f32::MAX` with the sign of the component, so no 0 · ∞ makes a NaN.
     /// Branch-free; the same values as the scalar `1 / x, else MAX.copysign(x)`.
     #[inline(always)]
-    pub fn with_inverse(o: Vec3, d0: Vec4, inv: Vec4) -> NodeRay {
+    pub fn with_inverse(neg_o: Vec3, d0: Vec4, inv: Vec4) -> NodeRay {
         let finite = inv.abs().cmplt(Vec4::splat(f32::INFINITY));
         let inv_d = Vec4::select(finite, inv, Vec4::splat(f32::MAX).copysign(d0));
         let neg = d0.cmplt(Vec4::ZERO).bitmask() as usize;
         // 8 × (row of the near plane): the axis's min row (2a), or its max row when d[a] < 0.
         let (nx, ny, nz) = ((neg & 1) << 3, (neg & 2) << 2, (neg & 4) << 1);
         NodeRay {
-            o: o.to_array(),
+            neg_o: neg_o.to_array(),
             inv_d: inv_d.truncate().to_array(),
             near: [nx, 16 + ny, 32 + nz],
             far: [8 - nx, 24 - ny, 40 - nz],
@@ -69,7 +72,11 @@ impl TraceRay {
     pub fn new(o: Vec3, d: Vec3) -> TraceRay {
         let d0 = Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO;
         let inv = Vec4::ONE / d0;
-        TraceRay { node: NodeRay::with_inverse(o, d0, inv), wt: WatertightRay::with_inverse(o, d, inv) }
+        // Opaque to the optimiser, which would otherwise turn `b + (−o)` back into `b − o`.
+        let neg_o = std::hint::black_box(-o);
+        let node = NodeRay::with_inverse(neg_o, d0, inv);
+        let neg = d0.cmplt(Vec4::ZERO).bitmask() & 7;
+        TraceRay { node, wt: WatertightRay::with_inverse_octant(neg_o, d, inv, neg) }
     }
 }
 
@@ -81,8 +88,8 @@ pub fn node_test_portable(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f3
     for h in 0..2 {
         let row = |off: usize| Vec4::from_slice(&node.bounds.as_flattened()[off + 4 * h..off + 4 * h + 4]);
         let slab = |a: usize| {
-            let (o, inv) = (Vec4::splat(r.o[a]), Vec4::splat(r.inv_d[a]));
-            ((row(r.near[a]) - o) * inv, (row(r.far[a]) - o) * inv)
+            let (neg_o, inv) = (Vec4::splat(r.neg_o[a]), Vec4::splat(r.inv_d[a]));
+            ((row(r.near[a]) + neg_o) * inv, (row(r.far[a]) + neg_o) * inv)
         };
         let (nx, fx) = slab(0);
         let (ny, fy) = slab(1);
@@ -104,12 +111,12 @@ macro_rules! node_test_avx_body {
         let (node, r, tmax, t_near): (&Node8, &NodeRay, f32, &mut [f32; 8]) = ($node, $r, $tmax, $t_near);
         macro_rules! slab {
             ($a:expr) => {{
-                let o = _mm256_set1_ps(r.o[$a]);
+                let neg_o = _mm256_set1_ps(r.neg_o[$a]);
                 let inv = _mm256_set1_ps(r.inv_d[$a]);
                 // SAFETY: `r.near`/`r.far` are row offsets as `NodeRay::with_inverse` sets them.
                 let near = _mm256_loadu_ps(unsafe { node.row(r.near[$a]) });
                 let far = _mm256_loadu_ps(unsafe { node.row(r.far[$a]) });
-                (_mm256_mul_ps(_mm256_sub_ps(near, o), inv), _mm256_mul_ps(_mm256_sub_ps(far, o), inv))
+                (_mm256_mul_ps(_mm256_add_ps(near, neg_o), inv), _mm256_mul_ps(_mm256_add_ps(far, neg_o), inv))
             }};
         }
         let (nx, fx) = slab!(0);

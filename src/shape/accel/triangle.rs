@@ -55,6 +55,10 @@ pub fn shear_axes(d: Vec3) -> ([usize; 3], [f32; 3]) {
     ([kx, ky, kz], [d[kx] * sz, d[ky] * sz, sz])
 }
 
+/// `(kx, ky)` of [`shear_axes`] by row `2 · kz + (d[kz] < 0)`: the axes following `kz`, swapped
+/// when `d[kz]` is negative.
+const AXES: [[u8; 2]; 6] = [[1, 2], [2, 1], [2, 0], [0, 2], [0, 1], [1, 0]];
+
 /// Per-ray precomputation of the watertight test (Woop et al. 2013, Sec. 3).
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
@@ -63,20 +67,34 @@ pub struct WatertightRay {
     k: [usize; 3],
     /// Shear (sx, sy, sz), splatted.
     s: [Vec4; 3],
-    /// Ray origin in the permuted axes, splatted.
-    o: [Vec4; 3],
+    /// Minus the ray origin in the permuted axes, splatted (`v + (−o)` is `v − o` bit for bit, and
+    /// takes the vertex row as a memory operand).
+    neg_o: [Vec4; 3],
+}
+
+/// The edge functions recomputed in `f64` (Woop et al. 2013, Sec. 3.3) in the lanes of `lanes`,
+/// the `f32` ones `uvw` elsewhere; `p` holds the sheared (ax, ay, bx, by, cx, cy).
+#[inline(always)]
+fn edges_f64(lanes: u32, p: [Vec4; 6], uvw: [Vec4; 3]) -> (Vec4, Vec4, Vec4) {
+    let (ax, ay, bx, by) = (p[0].as_dvec4(), p[1].as_dvec4(), p[2].as_dvec4(), p[3].as_dvec4());
+    let (cx, cy) = (p[4].as_dvec4(), p[5].as_dvec4());
+    let u = (cx * by - cy * bx).as_vec4();
+    let v = (ax * cy - ay * cx).as_vec4();
+    let w = (bx * ay - by * ax).as_vec4();
+    let m = glam::BVec4A::new(lanes & 1 != 0, lanes & 2 != 0, lanes & 4 != 0, lanes & 8 != 0);
+    (Vec4::select(m, u, uvw[0]), Vec4::select(m, v, uvw[1]), Vec4::select(m, w, uvw[2]))
 }
 
 /// Sheared vertex coordinates (x, y, z) of one vertex in the four lanes.
 #[inline(always)]
 fn sheared(w: &WatertightRay, p: &TriPacket4, j: usize) -> (Vec4, Vec4, Vec4) {
     let v = &p.v[j];
-    // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse`),
+    // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse_octant`),
     // so the four floats from each offset are one row of `v`.
     let row = |k: usize| unsafe { Vec4::from_array(*v.as_ptr().cast::<f32>().add(k).cast::<[f32; 4]>()) };
-    let rx = row(w.k[0]) - w.o[0];
-    let ry = row(w.k[1]) - w.o[1];
-    let rz = row(w.k[2]) - w.o[2];
+    let rx = row(w.k[0]) + w.neg_o[0];
+    let ry = row(w.k[1]) + w.neg_o[1];
+    let rz = row(w.k[2]) + w.neg_o[2];
     (rx - w.s[0] * rz, ry - w.s[1] * rz, w.s[2] * rz)
 }
 
@@ -84,36 +102,52 @@ impl WatertightRay {
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         let d0 = Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO;
-        Self::with_inverse(o, d, Vec4::ONE / d0)
+        Self::with_inverse(-o, d, Vec4::ONE / d0)
     }
 
     /// The test's state from axes `k` and shear `s` as [`shear_axes`] gives them.
     pub fn from_parts(k: [usize; 3], s: [f32; 3], o: Vec3) -> Self {
         assert!(k.iter().all(|&a| a < 3), "axes {k:?}");
-        WatertightRay { k: k.map(|a| 4 * a), s: s.map(Vec4::splat), o: k.map(|a| Vec4::splat(o[a])) }
+        WatertightRay { k: k.map(|a| 4 * a), s: s.map(Vec4::splat), neg_o: k.map(|a| Vec4::splat(-o[a])) }
     }
 
-    /// [`WatertightRay::new`] given `inv` = 1 / (d + 0) per axis (the node test's unclamped inverse,
+    /// [`WatertightRay::new`] given `neg_o` = −o and `inv` = 1 / (d + 0) per axis (the node test's unclamped inverse,
     /// so that one division serves both): the axes of [`shear_axes`] chosen without branches, and
     /// `sz` read from `inv` (the same division; it differs from `1 / d[kz]` only in the sign of an
     /// infinity when `d` is zero, where every lane is NaN and misses either way).
     #[inline(always)]
-    pub fn with_inverse(o: Vec3, d: Vec3, inv: Vec4) -> Self {
+    pub fn with_inverse(neg_o: Vec3, d: Vec3, inv: Vec4) -> Self {
+        let neg = (d + Vec3::ZERO).cmplt(Vec3::ZERO).bitmask();
+        Self::with_inverse_octant(neg_o, d, inv, neg)
+    }
+
+    /// [`WatertightRay::with_inverse`] given also `neg`, the sign bits of `d + 0` (bit `a` set when
+    /// `d[a] < 0`; the node test's octant). The axes come from one table row: the dominant axis
+    /// `kz` and the sign of `d[kz]` (a zero `d[kz]`, i.e. `d` zero, counts as positive, as
+    /// `d[kz] < 0.0` does for ±0).
+    #[inline(always)]
+    pub fn with_inverse_octant(neg_o: Vec3, d: Vec3, inv: Vec4, neg: u32) -> Self {
         let a = d.abs();
         let (xy, xz, yz) = ((a.x > a.y) as usize, (a.x > a.z) as usize, (a.y > a.z) as usize);
         // shear_axes: a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2).
         let kz = if xy != 0 { 2 - 2 * xz } else { 2 - yz };
-        let (d, o, inv) = (d.to_array(), o.to_array(), inv.to_array());
-        let next = |k: usize| if k == 2 { 0 } else { k + 1 };
-        let (mut kx, mut ky) = (next(kz), next(next(kz)));
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let sz = inv[kz];
+        let [kx, ky] = AXES[2 * kz + ((neg >> kz) & 1) as usize].map(usize::from);
+        let (d, o, inv) = (d.to_array(), neg_o.to_array(), inv.to_array());
+        // SAFETY: `kx`, `ky` (rows of `AXES`) and `kz` are below 3.
+        let (dx, dy, ox, oy, oz, sz) = unsafe {
+            (
+                d.get_unchecked(kx),
+                d.get_unchecked(ky),
+                o.get_unchecked(kx),
+                o.get_unchecked(ky),
+                o.get_unchecked(kz),
+                inv.get_unchecked(kz),
+            )
+        };
         WatertightRay {
             k: [4 * kx, 4 * ky, 4 * kz],
-            s: [Vec4::splat(d[kx] * sz), Vec4::splat(d[ky] * sz), Vec4::splat(sz)],
-            o: [Vec4::splat(o[kx]), Vec4::splat(o[ky]), Vec4::splat(o[kz])],
+            s: [Vec4::splat(dx * sz), Vec4::splat(dy * sz), Vec4::splat(*sz)],
+            neg_o: [Vec4::splat(*ox), Vec4::splat(*oy), Vec4::splat(*oz)],
         }
     }
 
@@ -131,20 +165,9 @@ impl WatertightRay {
         let exact_zero = (u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero)).bitmask();
         if exact_zero != 0 {
             // An edge function exactly 0 (the ray meets an edge or vertex in float precision):
-            // recompute that lane's three in double precision, as the paper does.
-            let (ax, ay, bx, by, cx, cy) =
-                (ax.to_array(), ay.to_array(), bx.to_array(), by.to_array(), cx.to_array(), cy.to_array());
-            let (mut ua, mut va, mut wa) = (u.to_array(), v.to_array(), w.to_array());
-            for l in 0..4 {
-                if exact_zero & (1 << l) != 0 {
-                    let (ax, bx, cx) = (ax[l] as f64, bx[l] as f64, cx[l] as f64);
-                    let (ay, by, cy) = (ay[l] as f64, by[l] as f64, cy[l] as f64);
-                    ua[l] = (cx * by - cy * bx) as f32;
-                    va[l] = (ax * cy - ay * cx) as f32;
-                    wa[l] = (bx * ay - by * ax) as f32;
-                }
-            }
-            (u, v, w) = (Vec4::from_array(ua), Vec4::from_array(va), Vec4::from_array(wa));
+            // recompute that lane's three in double precision, as the paper does (all four lanes
+            // at once, kept only where needed; the same products and roundings as scalar code).
+            (u, v, w) = edges_f64(exact_zero, [ax, ay, bx, by, cx, cy], [u, v, w]);
         }
         let neg = (u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero)).bitmask();
         let pos = (u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero)).bitmask();
