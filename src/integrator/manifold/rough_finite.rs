@@ -29,9 +29,7 @@
 //! ([`sample_plane`], [`nee_weight`], [`bsdf_hit_weight`], [`snee_weight`]).
 
 use super::planes::RoughPlane;
-use super::rough_lobe::{
-    self, on_boundary, on_plane, Reference, RoughPdfs, RoughTechnique, VisitedFrame, REFINE_STEPS,
-};
+use super::rough_lobe::{self, on_boundary, on_plane, Reference, RoughPdfs, RoughTechnique, REFINE_STEPS};
 use super::MediumVertex;
 use crate::bsdf::fresnel::{fresnel, refract};
 use crate::bsdf::{Bsdf, BsdfContext};
@@ -206,78 +204,18 @@ pub fn point_reference_gated(
             if u_rate.is_some_and(|u| u as f64 >= q) {
                 return Some(None);
             }
-            let mut visited = [None; REFINE_STEPS];
-            for slot in visited.iter_mut() {
+            for _ in 0..REFINE_STEPS {
                 let eta = eta_of(scene.bsdf(&si));
                 let Some(d) = refracted_reverse(si.sh_frame, eta, towards(si.p)) else { break };
                 stats.rays += 1;
                 match scene.ray_intersect(&Ray::new(p_j, d)) {
-                    Some(next) if on_boundary(scene, &next, medium, d) => {
-                        let bsdf = scene.shapes[si.shape as usize].bsdf;
-                        *slot = Some(VisitedFrame { frame: si.sh_frame, bsdf, omega_ref: towards(si.p) });
-                        si = next;
-                    }
+                    Some(next) if on_boundary(scene, &next, medium, d) => si = next,
                     _ => break,
                 }
             }
-            let reference = Reference { q, visited, ..Reference::of_point(scene, &si) };
+            let reference = Reference { q, ..Reference::of_point(scene, &si) };
             Some(Some((reference, towards(si.p))))
         }
-    }
-}
-
-/// Share of the frames the refinement passed through ([`VisitedFrame`]: `x_0`, `x_1`) in the
-/// connection's mixture on a curved boundary, split evenly between them; the refined reference
-/// keeps the rest (docs/manifold.md §7.2 "Visited frames").
-pub const VISITED_SHARE: f32 = 0.5;
-
-/// The frame of `visited` as a reference with `reference`'s other parts (the wide lobe, the rate).
-fn visited_reference(reference: &Reference, visited: &VisitedFrame) -> Reference {
-    Reference { frame: visited.frame, bsdf: visited.bsdf, visited: [None; REFINE_STEPS], ..*reference }
-}
-
-/// The inner direction's density of the connection in `reference` (towards the light point along
-/// `omega_ref` from the reference point): `rough_lobe::pdf_inner_ref`, mixed on a curved
-/// boundary with the same in the frames the refinement passed through ([`VISITED_SHARE`] split
-/// evenly among them). A function of `(x_j, y)` like the reference.
-pub fn pdf_imp(scene: &Scene, reference: &Reference, omega_ref: Vec3, omega_jk: Vec3) -> f64 {
-    let p = rough_lobe::pdf_inner_ref(scene, reference, omega_ref, omega_jk);
-    let k = reference.visited.iter().flatten().count();
-    if k == 0 {
-        return p;
-    }
-    let b = VISITED_SHARE as f64;
-    let earlier: f64 = reference
-        .visited
-        .iter()
-        .flatten()
-        .map(|v| rough_lobe::pdf_inner_ref(scene, &visited_reference(reference, v), v.omega_ref, omega_jk))
-        .sum();
-    (1.0 - b) * p + b * earlier / k as f64
-}
-
-/// Sample [`pdf_imp`]: `u1` picks the frame (where the refinement passed through others) and is
-/// rescaled, uniform again.
-pub fn sample_imp(scene: &Scene, reference: &Reference, omega_ref: Vec3, u1: f32, u2: Vec2) -> Option<Vec3> {
-    let k = reference.visited.iter().flatten().count();
-    if k == 0 {
-        return rough_lobe::sample_inner_ref(scene, reference, omega_ref, u1, u2);
-    }
-    let b = VISITED_SHARE;
-    let below = 1.0 - f32::EPSILON;
-    if u1 < b {
-        let x = (u1 / b * k as f32).min(k as f32 * below);
-        let i = (x as usize).min(k - 1);
-        let v = reference.visited.iter().flatten().nth(i)?;
-        rough_lobe::sample_inner_ref(
-            scene,
-            &visited_reference(reference, v),
-            v.omega_ref,
-            (x - i as f32).min(below),
-            u2,
-        )
-    } else {
-        rough_lobe::sample_inner_ref(scene, reference, omega_ref, ((u1 - b) / (1.0 - b)).min(below), u2)
     }
 }
 
@@ -312,7 +250,7 @@ pub fn density(
         return 0.0;
     }
     let Some((r, omega_ref)) = point_reference(scene, x_j.medium, plane, x_j.p, end.y, stats) else { return 0.0 };
-    let p_imp = pdf_imp(scene, &r, omega_ref, omega_jk);
+    let p_imp = rough_lobe::pdf_inner_ref(scene, &r, omega_ref, omega_jk);
     super::rough_rate::of_vertex(scene, x_j.medium, r.q) * combine(p_y, p_imp, si_k, end)
 }
 
@@ -394,7 +332,7 @@ pub fn connect(
     };
     // u1 < q: rescaled, uniform again.
     let u1 = super::rough_rate::rescale(u1, reference.q);
-    let omega_jk = sample_imp(scene, &reference, omega_ref, u1, u2)?;
+    let omega_jk = rough_lobe::sample_inner_ref(scene, &reference, omega_ref, u1, u2)?;
     let Some(si_k) = rough_lobe::trace_inner(scene, x_j, plane, omega_jk, stats) else {
         return fail(stats);
     };
@@ -408,7 +346,7 @@ pub fn connect(
     if tr == Spectrum::ZERO || le == Spectrum::ZERO {
         return fail(stats);
     }
-    let p_imp = pdf_imp(scene, &reference, omega_ref, omega_jk);
+    let p_imp = rough_lobe::pdf_inner_ref(scene, &reference, omega_ref, omega_jk);
     // The caller ran the connection with probability q (`rough_rate.rs`).
     let q = super::rough_rate::of_vertex(scene, x_j.medium, reference.q);
     let p_man = q * combine(p_y, p_imp, &si_k, &end);

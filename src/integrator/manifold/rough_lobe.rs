@@ -31,45 +31,19 @@ pub struct Reference {
     /// The depth factor of the connection's rate at this `x_j` (`rough_rate::depth_rate`; 1 on a
     /// plane), a factor of `p_man` with the medium's rate.
     pub q: f64,
-    /// The boundary points the refinement passed through before the reference's (`x_0`, `x_1`;
-    /// area lights on a curved boundary only, `rough_finite::point_reference`): the connection
-    /// samples their frames too, with probability `rough_finite::VISITED_SHARE` (docs/manifold.md
-    /// §7.2 "Visited frames").
-    pub visited: [Option<VisitedFrame>; REFINE_STEPS],
-}
-
-/// A boundary point the refinement of a curved reference passed through: its shading frame and
-/// BSDF, and the direction from it towards the light point.
-#[derive(Clone, Copy, Debug)]
-pub struct VisitedFrame {
-    pub frame: Frame,
-    pub bsdf: u32,
-    pub omega_ref: Vec3,
 }
 
 impl Reference {
     /// The frame of a flat orientation (any tangent: the roughness is isotropic).
     #[inline]
     pub fn of_plane(plane: &RoughPlane) -> Self {
-        Reference {
-            frame: Frame::from_normal(plane.n),
-            bsdf: plane.bsdf,
-            wide: false,
-            q: 1.0,
-            visited: [None; REFINE_STEPS],
-        }
+        Reference { frame: Frame::from_normal(plane.n), bsdf: plane.bsdf, wide: false, q: 1.0 }
     }
 
     /// The shading frame and BSDF of the boundary point `si` of a curved boundary (`wide`).
     #[inline]
     pub fn of_point(scene: &Scene, si: &SurfaceInteraction) -> Self {
-        Reference {
-            frame: si.sh_frame,
-            bsdf: scene.shapes[si.shape as usize].bsdf,
-            wide: true,
-            q: 1.0,
-            visited: [None; REFINE_STEPS],
-        }
+        Reference { frame: si.sh_frame, bsdf: scene.shapes[si.shape as usize].bsdf, wide: true, q: 1.0 }
     }
 }
 
