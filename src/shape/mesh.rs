@@ -259,6 +259,7 @@ impl Mesh {
 
     /// Uniform by area: pick a triangle by area, then a uniform point on it, `p0 + e0 b1 + e1 b2`
     /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges).
+    #[inline(always)]
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
         let total = self.surface_area();
         // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf).
