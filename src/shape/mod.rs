@@ -114,6 +114,8 @@ impl Shape {
         }
     }
 
+    /// (Inlined into `Scene::ray_intersect`: the record is built in place.)
+    #[inline(always)]
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray: &Ray) -> SurfaceInteraction {
         match &self.geometry {
             Geometry::Mesh(m) => m.interaction(prim, b1, b2, t, ray.d),
