@@ -34,7 +34,7 @@ pub fn from_desc(obj: &ObjectDesc, resolver: &FileResolver) -> Result<Texture> {
 }
 
 /// Sample a direction from `ref_p` towards `shape`: (ds, radiance / pdf), zero towards its back.
-#[inline]
+#[inline(always)]
 pub fn sample_direction(radiance: &Texture, shape: &Shape, ref_p: Vec3, sample: Vec2) -> (DirectionSample, Spectrum) {
     let ds = shape.sample_direction(ref_p, sample);
     // Emission only from the front side (Mitsuba's area emitter is one-sided).

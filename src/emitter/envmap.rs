@@ -190,7 +190,7 @@ impl EnvironmentEmitter {
     #[inline]
     pub fn eval_uv(&self, uv: Vec2) -> Spectrum {
         let (w, h) = (self.width, self.height);
-        let uv = Vec2::new(fract(uv.x - self.half_texel()), fract(uv.y));
+        let uv = Vec2::new(fast::fract(uv.x - self.half_texel()), fast::fract(uv.y));
         let x = uv.x * w as f32;
         let y = uv.y * (h - 1) as f32;
         // Float → integer casts saturate (NaN → 0), so the indices stay in range; through u32
@@ -227,7 +227,7 @@ impl EnvironmentEmitter {
     #[inline]
     fn cell_of(&self, uv: Vec2) -> (usize, usize) {
         let u = uv.x - self.half_texel();
-        let x = fract(u) * self.width as f32;
+        let x = fast::fract(u) * self.width as f32;
         let y = uv.y.clamp(0.0, 1.0) * (self.height - 1) as f32;
         ((x as u32 as usize).min(self.width - 1), (y as u32 as usize).min(self.height - 2))
     }
@@ -309,18 +309,6 @@ impl std::fmt::Debug for EnvironmentEmitter {
 }
 
 /// True when the linear part of `m` is orthogonal (a rotation, possibly with mirroring).
-/// `v − floor(v)` without a libm call (the baseline x86-64 has no `roundss`): the same value for
-/// every input (NaN and infinities give NaN; up to the sign of a zero result).
-#[inline(always)]
-fn fract(v: f32) -> f32 {
-    if !(v.abs() < 8_388_608.0) {
-        // Integers already (2^23 and above): 0; not finite: NaN.
-        return if v.is_finite() { 0.0 } else { f32::NAN };
-    }
-    let i = v as i32 as f32;
-    v - if i > v { i - 1.0 } else { i }
-}
-
 fn is_orthogonal(m: &Mat4) -> bool {
     let a = crate::math::Mat3::from_mat4(*m);
     let g = a.transpose() * a;
@@ -334,18 +322,6 @@ mod tests {
 
     fn gradient_map(w: usize, h: usize) -> Vec<Spectrum> {
         (0..w * h).map(|i| Spectrum::new((i % w) as f32 + 1.0, (i / w) as f32 + 0.5, 1.0)).collect()
-    }
-
-    #[test]
-    fn fract_is_v_minus_floor() {
-        for i in -40_000..40_000 {
-            let v = i as f32 * 0.000_731 + 1e-3;
-            assert_eq!(fract(v), v - v.floor(), "fract({v})");
-        }
-        for v in [0.0f32, 1.0, -1.0, -1e-30, 0.999_999_94, -0.999_999_94, 8_388_607.5, -8_388_607.5, 1e10, -3e9] {
-            assert_eq!(fract(v), v - v.floor(), "fract({v})");
-        }
-        assert!(fract(f32::NAN).is_nan() && fract(f32::INFINITY).is_nan());
     }
 
     #[test]

@@ -131,6 +131,18 @@ pub fn atan2(y: f32, x: f32) -> f32 {
     r.copysign(y)
 }
 
+/// `v − floor(v)` without a libm call (the baseline x86-64 has no `roundss`): the same value for
+/// every input (NaN and infinities give NaN; up to the sign of a zero result).
+#[inline(always)]
+pub fn fract(v: f32) -> f32 {
+    if !(v.abs() < 8_388_608.0) {
+        // Integers already (2^23 and above): 0; not finite: NaN.
+        return if v.is_finite() { 0.0 } else { f32::NAN };
+    }
+    let i = v as i32 as f32;
+    v - if i > v { i - 1.0 } else { i }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -218,5 +230,17 @@ mod tests {
             assert_eq!(atan2(y, x).to_bits(), y.atan2(x).to_bits(), "atan2({y}, {x})");
         }
         assert!(atan2(f32::NAN, 1.0).is_nan() && atan2(1.0, f32::NAN).is_nan());
+    }
+
+    #[test]
+    fn fract_is_v_minus_floor() {
+        for i in -40_000..40_000 {
+            let v = i as f32 * 0.000_731 + 1e-3;
+            assert_eq!(fract(v), v - v.floor(), "fract({v})");
+        }
+        for v in [0.0f32, 1.0, -1.0, -1e-30, 0.999_999_94, -0.999_999_94, 8_388_607.5, -8_388_607.5, 1e10, -3e9] {
+            assert_eq!(fract(v), v - v.floor(), "fract({v})");
+        }
+        assert!(fract(f32::NAN).is_nan() && fract(f32::INFINITY).is_nan());
     }
 }

@@ -121,6 +121,7 @@ impl Scene {
         !self.ray_test(&ray)
     }
 
+    #[inline(always)]
     fn sample_one_emitter(&self, index: usize, ref_p: Vec3, sample: Vec2) -> (DirectionSample, Spectrum) {
         match &self.emitters[index] {
             SceneEmitter::Other(e) => e.sample_direction(ref_p, sample),

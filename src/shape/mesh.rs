@@ -216,7 +216,7 @@ impl Mesh {
     /// The point at barycentrics `(b1, b2)` of triangle `prim` and its geometric normal (flipped
     /// with `flip_normals`): the part of [`Mesh::interaction`] that a shadow ray crossing the mesh
     /// needs (`walk::shadow_crossing`).
-    #[inline]
+    #[inline(always)]
     pub fn point_and_normal(&self, prim: u32, b1: f32, b2: f32) -> (Vec3, Vec3) {
         let [p0, p1, p2] = self.indices[prim as usize].map(|i| self.positions[i as usize]);
         let b0 = 1.0 - b1 - b2;
@@ -235,6 +235,7 @@ impl Mesh {
     }
 
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
+    #[inline(always)]
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
         let idx = self.indices[prim as usize];
         let (p, n) = self.point_and_normal(prim, b1, b2);
@@ -259,6 +260,7 @@ impl Mesh {
 
     /// Uniform by area: pick a triangle by area, then a uniform point on it, `p0 + e0 b1 + e1 b2`
     /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges).
+    #[inline(always)]
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
         let total = self.surface_area();
         // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf).

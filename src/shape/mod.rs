@@ -114,6 +114,8 @@ impl Shape {
         }
     }
 
+    /// (Inlined into `Scene::ray_intersect`: the record is built in place.)
+    #[inline(always)]
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray: &Ray) -> SurfaceInteraction {
         match &self.geometry {
             Geometry::Mesh(m) => m.interaction(prim, b1, b2, t, ray.d),
@@ -131,10 +133,13 @@ impl Shape {
     }
 
     /// A point on the shape seen from `ref_p`, with its solid-angle density (Mitsuba's `Shape::sample_direction`).
+    /// (Inlined whole into emitter sampling: no position-sample record passed between calls.)
+    #[inline(always)]
     pub fn sample_direction(&self, ref_p: Vec3, sample: Vec2) -> DirectionSample {
         match &self.geometry {
             Geometry::Sphere(s) => s.sample_direction(ref_p, sample),
-            _ => sphere::area_to_direction_sample(ref_p, self.sample_position(sample)),
+            Geometry::Mesh(m) => sphere::area_to_direction_sample(ref_p, m.sample_position(sample)),
+            Geometry::Disk(d) => sphere::area_to_direction_sample(ref_p, d.sample_position(sample)),
         }
     }
 

@@ -195,6 +195,7 @@ pub fn intersect_sphere(center: Vec3, r2: f32, o: Vec3, d: Vec3, tmax: f32) -> O
 }
 
 /// Convert an area sample seen from `ref_p` to a direction sample with a solid-angle pdf.
+#[inline(always)]
 pub fn area_to_direction_sample(ref_p: Vec3, ps: PositionSample) -> DirectionSample {
     let delta = ps.p - ref_p;
     let dist = delta.length();

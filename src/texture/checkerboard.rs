@@ -23,7 +23,7 @@
 
 use super::{uv_transform, Texture};
 use crate::color::Spectrum;
-use crate::math::Vec2;
+use crate::math::{fast, Vec2};
 use crate::scene::desc::Props;
 use crate::scene::resolver::FileResolver;
 use crate::scene::Result;
@@ -47,8 +47,9 @@ impl Checkerboard {
     #[inline]
     pub fn eval(&self, uv: Vec2) -> Spectrum {
         let t = self.to_uv.transform_point2(uv);
-        let mask_x = t.x - t.x.floor() > 0.5;
-        let mask_y = t.y - t.y.floor() > 0.5;
+        // `t − floor(t)` without a libm call (`fast::fract`, the same value).
+        let mask_x = fast::fract(t.x) > 0.5;
+        let mask_y = fast::fract(t.y) > 0.5;
         if mask_x == mask_y {
             self.color0.eval(uv)
         } else {
