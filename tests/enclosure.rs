@@ -90,3 +90,49 @@ fn skip_draws_what_the_shadow_ray_draws() {
         }
     }
 }
+
+/// `skip_sample_emitter` decides without sampling where it can (a constant sphere light seen from
+/// outside, `volpath::surely_usable`): it must draw exactly what the emitter sample would make it
+/// draw, at points inside the statue, near the light (inside it, on it, just outside) and far away.
+#[test]
+fn skip_decides_as_the_emitter_sample_does() {
+    let scene = load("scenes/paper/sphere_smooth_st34.xml");
+    let sphere = scene
+        .shapes
+        .iter()
+        .find_map(|s| match (&s.geometry, s.emitter) {
+            (Geometry::Sphere(sp), Some(_)) => Some(sp.clone()),
+            _ => None,
+        })
+        .expect("the sphere light");
+    let bounds = scene.shapes.iter().find(|s| s.interior.is_some()).expect("the statue").bounds();
+    let mut points = Sampler::new(13, 0);
+    let (mut usable, mut unusable) = (0, 0);
+    for i in 0..200_000u64 {
+        let u = Vec3::new(points.next_1d(), points.next_1d(), points.next_1d());
+        let p = match i % 4 {
+            // In the statue's box, and in a box 4 radii around the light's centre.
+            0 | 1 => bounds.min + u * (bounds.max - bounds.min),
+            2 => sphere.center + (u * 2.0 - Vec3::ONE) * (4.0 * sphere.radius),
+            // Within a few 1e-4 of the light's surface (both sides) and very far.
+            _ if i % 8 == 3 => {
+                let d = (u * 2.0 - Vec3::ONE).normalize_or(Vec3::Y);
+                sphere.center + d * sphere.radius * (1.0 + (points.next_1d() - 0.5) * 1e-3)
+            }
+            _ => sphere.center + (u * 2.0 - Vec3::ONE) * 1e5,
+        };
+        let mut skip = Sampler::new(17, i);
+        let mut full = skip.clone();
+        skip_sample_emitter(&scene, p, &mut skip);
+        let (ds, emitted) = scene.sample_emitter_direction(p, None, full.next_2d(), false);
+        if ds.pdf != 0.0 && emitted != snee::color::Spectrum::ZERO {
+            let _ = full.next_1d();
+            usable += 1;
+        } else {
+            unusable += 1;
+        }
+        assert_eq!(skip.next_1d(), full.next_1d(), "sample streams diverge at {p} ({i})");
+    }
+    // Both outcomes occur (inside the light no sample is usable towards its back).
+    assert!(usable > 1000 && unusable > 1000, "{usable} usable, {unusable} not");
+}

@@ -35,11 +35,13 @@ use crate::bsdf::{Bsdf, BsdfSample};
 use crate::color::Spectrum;
 use crate::interaction::offset_origin;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
-use crate::math::Vec3;
 use crate::math::{mis_weight, Ray};
+use crate::math::{Vec2, Vec3};
 use crate::medium::Homogeneous;
 use crate::sampler::Sampler;
-use crate::scene::world::Scene;
+use crate::scene::world::{Scene, SceneEmitter};
+use crate::shape::Geometry;
+use crate::texture::Texture;
 
 /// Sample an emitter from `r` and estimate the transmittance to it (Mitsuba's
 /// `VolumetricPathIntegrator::sample_emitter`). Returns (emitted · transmittance / pdf, ds).
@@ -64,12 +66,51 @@ pub fn sample_emitter(
 /// enclosure blocks every shadow ray, `integrator/enclosure.rs`): no ray is traced, but the same
 /// samples are drawn: the emitter sample, and when it is usable the one distance sample of the
 /// segment to the enclosing surface (which either ends it by a collision or blocks it).
+///
+/// Whether the emitter sample is usable is decided without sampling where [`surely_usable`] can
+/// tell (a constant sphere light seen from outside, away from its cone's rim); elsewhere the
+/// emitter is sampled as the shadow ray would. Either way the same samples are drawn.
 #[inline]
 pub fn skip_sample_emitter(scene: &Scene, p: Vec3, sampler: &mut Sampler) {
-    let (ds, emitted) = scene.sample_emitter_direction(p, None, sampler.next_2d(), false);
-    if ds.pdf != 0.0 && emitted != Spectrum::ZERO {
+    let u = sampler.next_2d();
+    let usable = surely_usable(scene, p, u) || {
+        let (ds, emitted) = scene.sample_emitter_direction(p, None, u, false);
+        ds.pdf != 0.0 && emitted != Spectrum::ZERO
+    };
+    if usable {
         let _ = sampler.next_1d();
     }
+}
+
+/// True when `Scene::sample_emitter_direction(p, None, u, false)` certainly returns a usable
+/// sample (`pdf > 0` and a finite, non-zero weight); false when that is not sure (the caller then
+/// samples). Certain, with margins far above `f32` rounding, for the emitter `u.x` selects being an
+/// `area` emitter of constant, finite radiance (some channel ≥ 1e-10) on a sphere with outward
+/// normals, seen from a point `p`
+/// - outside it by 1 % of `r²` (`Sphere::sample_direction` samples the subtended cone),
+/// - with the cone sample `u.y` away from the rim: `1 − u.y > 10⁻³`, so the direction hits the
+///   sphere with |cos| ≥ ~0.03 at the hit (the one-sided emitter's front faces it), and
+///   `(1 − u.y) r² > 2·10⁻⁵ |c − p|²`, so `cos θ − cos α = (1 − u.y)(1 − cos α) > 10⁻⁵` (the cone
+///   pdf is positive and finite, as `1 − cos α ≥ r² / 2|c − p|²`).
+#[inline]
+fn surely_usable(scene: &Scene, p: Vec3, u: Vec2) -> bool {
+    let n = scene.emitters.len();
+    if n == 0 {
+        return false;
+    }
+    // The emitter selection of `Scene::sample_emitter_direction`.
+    let index = ((u.x * n as f32) as u32 as usize).min(n - 1);
+    let SceneEmitter::Area { shape, radiance: Texture::Const(le) } = &scene.emitters[index] else {
+        return false;
+    };
+    let Geometry::Sphere(sphere) = &scene.shapes[*shape as usize].geometry else { return false };
+    if sphere.flip_normals || !crate::color::is_finite(*le) || !(le.abs().max_element() >= 1e-10) {
+        return false;
+    }
+    let dist2 = (sphere.center - p).length_squared();
+    let r2 = sphere.radius * sphere.radius;
+    let rim = 1.0 - u.y;
+    dist2 > r2 * 1.01 && rim > 1e-3 && rim * r2 > 2e-5 * dist2
 }
 
 /// Transmittance along a shadow ray up to `ray.tmax`, through null / thin-dielectric interfaces

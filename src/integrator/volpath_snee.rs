@@ -49,8 +49,19 @@ pub fn li(
         return volpath::li(scene, sampler, ray, medium, stats);
     }
     let (l, valid) = volpath::li_with(scene, sampler, ray, medium, stats, Some(snee));
-    // Glints from the camera (`connection = complete`, docs/manifold.md §10); zero, drawing nothing, elsewhere.
+    // Glints from the camera (`connection = complete`, docs/manifold.md §10); zero, drawing nothing,
+    // elsewhere, and without a directional light (which only they take): not even its camera map
+    // is built then.
+    if !has_directional(scene) {
+        return (l, valid);
+    }
     (l + manifold::glint::sample(scene, snee, sampler, &ray, stats), valid)
+}
+
+/// Has `scene` a `directional` emitter (the only emitters the camera's glints take)?
+#[inline]
+fn has_directional(scene: &Scene) -> bool {
+    scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_))))
 }
 
 /// The `snee`, `snee_rate` and `transport` parameters.
@@ -158,7 +169,7 @@ pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool 
     let no_connection = match connection {
         Connection::Paper => true,
         Connection::Complete => {
-            let directional = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_))));
+            let directional = has_directional(scene);
             snee.flat.iter().all(Option::is_none)
                 && snee.rough.iter().all(Option::is_none)
                 // The camera's glints (`manifold::glint`) take directional lights on any medium's

@@ -100,9 +100,21 @@ impl<'a> ManifoldStage<'a> {
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.arrived = self.tracker.surface_event();
-        self.rough_arrived = self.rough_pending.take();
-        self.curved_arrived = self.curved_pending.take();
-        self.hit = si.copied();
+        // The pending records are mostly `None` on both sides: then nothing is moved (each holds a
+        // whole `SurfaceInteraction`).
+        if self.rough_pending.is_some() || self.rough_arrived.is_some() {
+            self.rough_arrived = self.rough_pending.take();
+        }
+        if self.curved_pending.is_some() || self.curved_arrived.is_some() {
+            self.curved_arrived = self.curved_pending.take();
+        }
+        // `hit` is read only with a record that arrived or after a medium vertex `x_j` (`weight`,
+        // `nee_weight`); otherwise it is not copied and keeps no meaning.
+        let read = self.arrived.is_some()
+            || self.rough_arrived.is_some()
+            || self.curved_arrived.is_some()
+            || self.tracker.x_j.is_some();
+        self.hit = if read { si.copied() } else { None };
     }
 
     /// The weight of an emitter hit along `d` by forward tracing, when the manifold connection
@@ -140,7 +152,17 @@ impl<'a> ManifoldStage<'a> {
             None
         };
         self.curved_pending =
-            curved_finite::pending(scene, self.x_i, self.tracker.x_j, s, bs, wo, self.curved_arrived.take());
-        self.tracker.after_bsdf(scene, s, bs.sampled_type, wo, self.arrived.take());
+            curved_finite::pending(scene, self.x_i, self.tracker.x_j, s, bs, wo, take_some(&mut self.curved_arrived));
+        self.tracker.after_bsdf(scene, s, bs.sampled_type, wo, take_some(&mut self.arrived));
+    }
+}
+
+/// `o.take()` that moves nothing when `o` is `None` (the records are large and mostly `None`).
+#[inline(always)]
+fn take_some<T>(o: &mut Option<T>) -> Option<T> {
+    if o.is_some() {
+        o.take()
+    } else {
+        None
     }
 }

@@ -63,6 +63,18 @@ pub fn light_transmission(
     } else {
         f32::INFINITY
     };
+    if scene.surfaces_block_shadow_rays {
+        // Every surface stops the walk (none is passable): one any-hit query decides it, with the
+        // walk's value (1 or 0) and its ray count.
+        let ray = Ray { tmax, ..Ray::new(offset_origin(si_k.p, si_k.n, light.omega_l), light.omega_l) };
+        if !(tmax > 0.0) {
+            return Spectrum::ONE;
+        }
+        stats.rays += 1;
+        // A non-finite ray has no hit in `ray_intersect` (the walk's query); `ray_test` reports it blocked.
+        let blocked = (ray.o + ray.d).is_finite() && scene.ray_test(&ray);
+        return if blocked { Spectrum::ZERO } else { Spectrum::ONE };
+    }
     match walk_light_segment(scene, si_k, light.omega_l, tmax, false, stats) {
         (tr, None) => tr,
         _ => Spectrum::ZERO,

@@ -91,7 +91,10 @@ impl<'a> SneeStage<'a> {
             (Some((x_i, x_j)), Some(s)) if encloses(scene, s, x_i.medium, d) => Some(SneeSuffix { x_i, x_j, si_k: *s }),
             _ => None,
         };
-        self.arrived = self.pending.take();
+        // Both are mostly `None`: then nothing is moved (a suffix holds a whole `SurfaceInteraction`).
+        if self.pending.is_some() || self.arrived.is_some() {
+            self.arrived = self.pending.take();
+        }
     }
 
     /// The weight of a forward contribution with volpath weight `w_volpath`: an emitter hit by
