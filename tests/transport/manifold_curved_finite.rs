@@ -82,14 +82,28 @@ fn sphere_light_through_matched_pebble_agrees_with_null_boundary() {
 /// every angle, grazing (`cos θ_y ≤ 0.1`) included (the worst of each printed).
 #[test]
 fn technique_weights_sum_to_one_on_sampled_suffixes() {
+    weights_sum_to_one("pebble.ply");
+}
+
+/// The same on the non-convex blob, where the procedure's seeds find several distinct solutions
+/// at some vertices (each of them weighed; at least one such connection asserted).
+#[test]
+fn technique_weights_sum_to_one_on_the_blob_with_several_solutions() {
+    let multi = weights_sum_to_one("blob.ply");
+    assert!(multi > 0, "no connection with several solutions on the blob");
+}
+
+/// The check of the two tests above on `file`; returns how many connections found several solutions.
+fn weights_sum_to_one(file: &str) -> u32 {
     use snee::integrator::manifold::{curved_finite, finite, MediumVertex};
     use snee::integrator::snee::SneeVertex;
     use snee::integrator::stats::LocalStats;
     use snee::interaction::{offset_origin, spawn_ray_between};
     use snee::math::{Ray, Vec2, Vec3};
-    let scene = scene(&mesh("volpath_snee", COMPLETE, GLASS, "pebble.ply"), &[]);
+    let scene = scene(&mesh("volpath_snee", COMPLETE, GLASS, file), &[]);
     let opts = scene.integrator.snee;
     let mut rng = snee::sampler::Sampler::new(11, 1);
+    let mut multi = 0;
     let mut stats = LocalStats::default();
     let (mut checked, mut shared, mut hidden, mut worst, mut worst_grazing) = (0, 0, 0, 0.0f64, 0.0f64);
     for _ in 0..400 {
@@ -100,39 +114,44 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
         let finite::Pick::Finite(lp) = finite::pick(&scene, Vec2::new(rng.next_1d(), rng.next_1d())) else {
             panic!("the sphere light is the only emitter")
         };
-        let Some(c) = curved_finite::connect(&scene, opts, Some(&x_i), &x_j, &lp, 0.0, 0, &mut stats) else { continue };
-        // The forward path: the same suffix, the light hit along the refracted direction.
-        let omega_l = c.light.omega_l;
-        let mut hit =
-            scene.ray_intersect(&Ray::new(offset_origin(c.si_k.p, c.si_k.n, omega_l), omega_l)).expect("hits");
-        // The same suffix: the sampled point (the f32 hit differs from it by ~1e-6, which moves
-        // `G` by up to 1.6 % next to a caustic, a different path). The hit's own normal is kept:
-        // every side takes the sphere's normal from the light point (`curved_finite::light_normal`).
-        hit.p = lp.y;
-        let pending = curved_finite::Pending { x_i: Some(x_i), x_j, si_k: c.si_k, omega_jk: c.omega };
-        let w_fwd = curved_finite::forward_weight(&scene, opts, &pending, &hit, omega_l, 0, &mut stats).unwrap() as f64;
-        // SNEE makes the suffix only when x_k is visible from x_i (its probe's first hit); x_i can
-        // lie outside the inscribed mesh near its facets, and then SNEE's weight is not defined.
-        let inner_k = offset_origin(c.si_k.p, c.si_k.n, x_i.p - c.si_k.p);
-        if scene.ray_test(&spawn_ray_between(x_i.p, inner_k)) {
-            hidden += 1;
-            continue;
+        let connections = curved_finite::connect(&scene, opts, Some(&x_i), &x_j, &lp, 0.0, 0, &mut stats);
+        multi += (connections.len() > 1) as u32;
+        for c in connections {
+            // The forward path: the same suffix, the light hit along the refracted direction.
+            let omega_l = c.light.omega_l;
+            let mut hit =
+                scene.ray_intersect(&Ray::new(offset_origin(c.si_k.p, c.si_k.n, omega_l), omega_l)).expect("hits");
+            // The same suffix: the sampled point (the f32 hit differs from it by ~1e-6, which moves
+            // `G` by up to 1.6 % next to a caustic, a different path). The hit's own normal is kept:
+            // every side takes the sphere's normal from the light point (`curved_finite::light_normal`).
+            hit.p = lp.y;
+            let pending = curved_finite::Pending { x_i: Some(x_i), x_j, si_k: c.si_k, omega_jk: c.omega };
+            let w_fwd =
+                curved_finite::forward_weight(&scene, opts, &pending, &hit, omega_l, 0, &mut stats).unwrap() as f64;
+            // SNEE makes the suffix only when x_k is visible from x_i (its probe's first hit); x_i can
+            // lie outside the inscribed mesh near its facets, and then SNEE's weight is not defined.
+            let inner_k = offset_origin(c.si_k.p, c.si_k.n, x_i.p - c.si_k.p);
+            if scene.ray_test(&spawn_ray_between(x_i.p, inner_k)) {
+                hidden += 1;
+                continue;
+            }
+            let suffix = snee::integrator::snee::SneeSuffix { x_i, x_j: x_j.p, si_k: c.si_k };
+            let w_snee = curved_finite::snee_weight(&scene, opts.technique, &suffix, &c.light, 0).unwrap();
+            let sum = c.weight + w_fwd + w_snee;
+            let cos_y = -lp.area.expect("an area light").0.dot(omega_l);
+            if cos_y > 0.1 {
+                worst = worst.max((sum - 1.0).abs());
+            } else {
+                worst_grazing = worst_grazing.max((sum - 1.0).abs());
+            }
+            checked += 1;
+            shared += (c.weight < 0.99 && (w_fwd > 0.01 || w_snee > 0.01)) as u32;
         }
-        let suffix = snee::integrator::snee::SneeSuffix { x_i, x_j: x_j.p, si_k: c.si_k };
-        let w_snee = curved_finite::snee_weight(&scene, opts.technique, &suffix, &c.light, 0).unwrap();
-        let sum = c.weight + w_fwd + w_snee;
-        let cos_y = -lp.area.expect("an area light").0.dot(omega_l);
-        if cos_y > 0.1 {
-            worst = worst.max((sum - 1.0).abs());
-        } else {
-            worst_grazing = worst_grazing.max((sum - 1.0).abs());
-        }
-        checked += 1;
-        shared += (c.weight < 0.99 && (w_fwd > 0.01 || w_snee > 0.01)) as u32;
     }
-    eprintln!("{checked} suffixes ({hidden} with x_k hidden from x_i skipped), {shared} shared (no weight above 0.99); worst |Σw − 1| = {worst:.2e} (cos θ_y > 0.1), {worst_grazing:.2e} (grazing)");
+    eprintln!("{file}: {checked} suffixes ({hidden} with x_k hidden from x_i skipped), {shared} shared (no weight above 0.99), {multi} connections with several solutions; worst |Σw − 1| = {worst:.2e} (cos θ_y > 0.1), {worst_grazing:.2e} (grazing)");
     assert!(checked > 50 && shared > 5, "too few suffixes checked ({checked}, {shared} shared)");
     assert!(worst < 1e-6 && worst_grazing < 1e-6, "weights sum to 1 ± {worst} (grazing ± {worst_grazing})");
+    multi
 }
 
 /// SNEE's default rate under `connection = complete` (docs/snee.md §5, `snee::rate::complete_rates`):
@@ -191,7 +210,10 @@ fn connection_rate_out_of_range_is_an_error() {
 fn diagnose_statue_forward_suffixes_found() {
     use crate::manifold_curved_statue::inside_point;
     use snee::integrator::manifold::locate::{boundary_patch, SceneLocate};
-    use snee::integrator::manifold::newton_point::{point_seed, solve_from_seeds};
+    use snee::integrator::manifold::newton::Failure;
+    use snee::integrator::manifold::newton_point::{
+        point_seed, refracted_seed_along, solve_distinct, solve_point, SEEDS,
+    };
     use snee::math::{DVec3, Ray, Vec3};
     let sigma_t: f64 = std::env::var("STATUE_SIGMA_T").ok().and_then(|s| s.parse().ok()).unwrap_or(34.0);
     let xml = std::fs::read_to_string(common::root().join("scenes/paper/sphere_smooth_st34.xml")).unwrap();
@@ -204,12 +226,18 @@ fn diagnose_statue_forward_suffixes_found() {
         .replace(r#"<float name="sigma_t" value="34"/>"#, &format!(r#"<float name="sigma_t" value="{sigma_t}"/>"#));
     let scene = common::scene(&xml, &[]);
     let center = Vec3::new(28.6788, 81.9152, 49.6732);
-    let variants = [1usize, 2, 6, 10];
+    // Seed sets, each tried in full (every distinct converged solution kept): the first seed; the
+    // chain of refracted seeds along the previous seed (`refracted_seed_along`); the first seed and
+    // a ring of 8 at 0.1 rad; the exact forward direction (reachability).
+    const SETS: usize = 7;
+    let names = ["first", "chain 2", "chain 3", "chain 4", "first + ring 8", "exact w (reach)", "procedure"];
     let mut rng = snee::sampler::Sampler::new(7, 1);
     let mut u = move || rng.next_1d() as f64;
-    let (mut total, mut hits) = (0.0f64, 0u32);
-    let mut found = [0.0f64; 4];
-    let mut cost = [(0u64, 0u64); 4];
+    let (mut total, mut hits, mut solutions) = (0.0f64, 0u32, 0u64);
+    let mut found = [0.0f64; SETS];
+    let mut cost = [(0u64, 0u64); SETS];
+    // The first seed's outcome on the suffixes it misses: no seed, another solution, lost, not converged.
+    let mut cause = [0.0f64; 4];
     let cos_max = 70f64.to_radians().cos();
     let mut vertices = 0;
     while vertices < 300 {
@@ -237,29 +265,96 @@ fn diagnose_statue_forward_suffixes_found() {
                 continue;
             }
             let y: DVec3 = hit.p.as_dvec3();
+            let x = x_j.as_dvec3();
             let weight = (-sigma_t * rf.t).exp();
             total += weight;
             hits += 1;
-            for (v, &n) in variants.iter().enumerate() {
+            for v in 0..SETS {
                 let mut locate = SceneLocate { scene: &scene, medium: 0, rays: 0 };
-                let mut solves = 0;
-                let first = point_seed(&mut locate, x_j.as_dvec3(), y);
-                let r = solve_from_seeds(&mut locate, x_j.as_dvec3(), y, first, n, &mut solves);
-                cost[v].0 += solves as u64;
+                let first = point_seed(&mut locate, x, y);
+                let mut seeds: Vec<DVec3> = Vec::new();
+                match v {
+                    0..=3 => {
+                        let mut s = first;
+                        for _ in 0..=v {
+                            let Some(d) = s else { break };
+                            seeds.push(d);
+                            s = refracted_seed_along(&mut locate, x, y, d);
+                        }
+                    }
+                    4 => {
+                        if let Some(f) = first {
+                            seeds.push(f);
+                            let t = snee::integrator::manifold::newton::tangents(f);
+                            for i in 0..8 {
+                                let a = i as f64 * std::f64::consts::FRAC_PI_4;
+                                seeds.push(snee::integrator::manifold::newton::moved(
+                                    f,
+                                    t,
+                                    0.1 * a.cos(),
+                                    0.1 * a.sin(),
+                                ));
+                            }
+                        }
+                    }
+                    _ => seeds.push(w),
+                }
+                if v == 6 {
+                    let d = solve_distinct(&mut locate, x, y, first, SEEDS);
+                    cost[v].0 += d.solves as u64;
+                    cost[v].1 += locate.rays;
+                    if d.solutions.iter().any(|s| (s.omega - w).length() < 1e-4) {
+                        found[v] += weight;
+                    }
+                    solutions += d.solutions.len() as u64;
+                    continue;
+                }
+                let mut sols: Vec<DVec3> = Vec::new();
+                let mut first_outcome = 0;
+                for (k, &sd) in seeds.iter().enumerate() {
+                    cost[v].0 += 1;
+                    let r = solve_point(&mut locate, x, y, sd);
+                    if k == 0 {
+                        first_outcome = match r {
+                            Ok(s) if (s.omega - w).length() < 1e-4 => 4,
+                            Ok(_) => 1,
+                            Err((Failure::Lost, _)) => 2,
+                            Err((Failure::NoConvergence, _)) => 3,
+                        };
+                    }
+                    if let Ok(s) = r {
+                        if sols.iter().all(|o| (*o - s.omega).length() >= 1e-4) {
+                            sols.push(s.omega);
+                        }
+                    }
+                }
                 cost[v].1 += locate.rays;
-                if matches!(r, Ok(s) if (s.omega - w).length() < 1e-4) {
+                if sols.iter().any(|o| (*o - w).length() < 1e-4) {
                     found[v] += weight;
+                }
+                if v == 0 && first_outcome != 4 {
+                    cause[if seeds.is_empty() { 0 } else { first_outcome }] += weight;
                 }
             }
         }
     }
     eprintln!("σt {sigma_t}: {vertices} vertices, {hits} forward suffixes reaching the light");
-    for (v, &n) in variants.iter().enumerate() {
+    for v in 0..SETS {
         eprintln!(
-            "seeds {n:2}: found {:.1} % of the weighted suffixes; {:.2} solves, {:.1} rays per call",
+            "{:>16}: found {:.1} % of the weighted suffixes; {:.2} solves, {:.1} rays per call",
+            names[v],
             100.0 * found[v] / total,
             cost[v].0 as f64 / hits as f64,
             cost[v].1 as f64 / hits as f64
         );
     }
+    eprintln!("procedure: {:.2} distinct solutions per call", solutions as f64 / hits as f64);
+    eprintln!(
+        "first seed's misses ({:.1} %): no seed {:.1} %, another solution {:.1} %, lost {:.1} %, not converged {:.1} %",
+        100.0 * cause.iter().sum::<f64>() / total,
+        100.0 * cause[0] / total,
+        100.0 * cause[1] / total,
+        100.0 * cause[2] / total,
+        100.0 * cause[3] / total
+    );
 }

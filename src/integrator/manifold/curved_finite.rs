@@ -23,7 +23,6 @@
 use super::finite::{self, LightPoint};
 use super::locate::{boundary_patch, SceneLocate};
 use super::mis::{self, EnvPdfs, EnvTechnique};
-use super::newton::Failure;
 use super::newton_point::{self, PointSolution};
 use super::{add_finite, MediumVertex};
 use crate::bsdf::fresnel::fresnel;
@@ -92,49 +91,39 @@ fn seed_line(
     (rate_at(rate(opts), sigma_t, t0), first)
 }
 
-/// Two directions are the same solution when they differ by less than this (radians).
-const SAME_SOLUTION: f64 = 1e-4;
-
-/// The deterministic solve from `x_j` towards `y` (`first`: [`seed_line`]'s seed), verified in the renderer's precision (the f32
-/// hit along the solution is the enclosing boundary from inside, at the solved point with the
-/// solved shading normal, and `y` lies outside both normals there). Counts the Newton work.
+/// The deterministic procedure from `x_j` towards `y` (`first`: [`seed_line`]'s seed;
+/// [`newton_point::solve_distinct`]: every distinct solution from a fixed set of seeds), each
+/// solution verified in the renderer's precision (the f32 hit along it is the enclosing boundary
+/// from inside, at the solved point with the solved shading normal, and `y` lies outside both
+/// normals there); the verified ones. Counts the Newton work.
 fn resolve(
     scene: &Scene,
     x_j: &MediumVertex,
     y: Vec3,
     first: Option<DVec3>,
     stats: &mut LocalStats,
-) -> Option<(PointSolution, SurfaceInteraction)> {
+) -> Vec<(PointSolution, SurfaceInteraction)> {
     let mut locate = SceneLocate { scene, medium: x_j.medium, rays: 0 };
-    let mut solves = 0;
     let (p, y64) = (x_j.p.as_dvec3(), y.as_dvec3());
-    let r = newton_point::solve_from_seeds(&mut locate, p, y64, first, newton_point::SEEDS, &mut solves);
+    let d = newton_point::solve_distinct(&mut locate, p, y64, first, newton_point::SEEDS);
     stats.rays += locate.rays;
-    stats.manifold_newton_solves += solves as u64;
-    let sol = match r {
-        Ok(s) => {
-            stats.manifold_newton_iterations += s.iterations as u64;
-            s
-        }
-        Err((f, it)) => {
-            stats.manifold_newton_iterations += it as u64;
-            match f {
-                Failure::Lost => stats.manifold_newton_lost += 1,
-                Failure::NoConvergence => stats.manifold_newton_failures += 1,
-            }
-            return None;
-        }
+    stats.manifold_newton_solves += d.solves as u64;
+    stats.manifold_newton_iterations += d.iterations as u64;
+    stats.manifold_newton_lost += d.lost as u64;
+    stats.manifold_newton_failures += d.not_converged as u64;
+    let verify = |sol: PointSolution, stats: &mut LocalStats| {
+        let omega = sol.omega.as_vec3().normalize();
+        stats.rays += 1;
+        let si = scene.ray_intersect(&Ray::new(x_j.p, omega))?;
+        let to_y = y - si.p;
+        let ok = boundary_patch(scene, &si, x_j.medium, omega).is_some()
+            && si.n.dot(to_y) > 0.0
+            && si.sh_frame.n.dot(to_y) > 0.0
+            && (si.p.as_dvec3() - sol.refracted.x_k).length() <= 1e-3 * (1.0 + sol.refracted.t)
+            && si.sh_frame.n.as_dvec3().dot(sol.refracted.n_s) > 1.0 - 1e-4;
+        ok.then_some((sol, si))
     };
-    let omega = sol.omega.as_vec3().normalize();
-    stats.rays += 1;
-    let si = scene.ray_intersect(&Ray::new(x_j.p, omega))?;
-    let to_y = y - si.p;
-    let ok = boundary_patch(scene, &si, x_j.medium, omega).is_some()
-        && si.n.dot(to_y) > 0.0
-        && si.sh_frame.n.dot(to_y) > 0.0
-        && (si.p.as_dvec3() - sol.refracted.x_k).length() <= 1e-3 * (1.0 + sol.refracted.t)
-        && si.sh_frame.n.as_dvec3().dot(sol.refracted.n_s) > 1.0 - 1e-4;
-    ok.then_some((sol, si))
+    d.solutions.into_iter().filter_map(|sol| verify(sol, stats)).collect()
 }
 
 /// The densities of `x_j → x_k → y` (solid angle of `ω_jk` at `x_j`): the connection's `p_man`
@@ -228,12 +217,13 @@ fn density(
     }
     stats.manifold_resolves += 1;
     let (q, first) = seed_line(scene, opts, x_j, y, stats);
-    match resolve(scene, x_j, y, first, stats) {
-        Some((sol, _)) if (sol.omega - omega_jk.as_dvec3()).length() < SAME_SOLUTION => {
+    let solutions = resolve(scene, x_j, y, first, stats);
+    match solutions.iter().find(|(sol, _)| (sol.omega - omega_jk.as_dvec3()).length() < newton_point::SAME_SOLUTION) {
+        Some((sol, _)) => {
             stats.manifold_resolve_matches += 1;
             q * mis::area_density(p_y, sol.g, cos_y)
         }
-        _ => 0.0,
+        None => 0.0,
     }
 }
 
@@ -252,8 +242,9 @@ pub struct PointConnection {
 /// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`), run with
 /// probability `q(x_j, y)` ([`rate_at`]: it runs when the uniform `u_rate` is below it; the straight
 /// line's ray is cast only when `u_rate` is below the top rate [`rate`]): solve from the
-/// deterministic seed, verify, value (divided by `q`), and MIS-weight against forward tracing and
-/// SNEE. Counts solutions and failures.
+/// deterministic seeds, verify, and value (divided by `q`) and MIS-weight against forward tracing
+/// and SNEE EVERY distinct solution found (their sum is the estimate: each suffix of the set is
+/// one sample of the technique, docs/manifold.md §8.2). Counts solutions and failures.
 #[allow(clippy::too_many_arguments)]
 pub fn connect(
     scene: &Scene,
@@ -264,58 +255,70 @@ pub fn connect(
     u_rate: f64,
     channel: usize,
     stats: &mut LocalStats,
-) -> Option<PointConnection> {
-    let fail = |stats: &mut LocalStats| {
-        stats.manifold_failures += 1;
-        None
-    };
+) -> Vec<PointConnection> {
     let (Some((n_y, uv)), SceneEmitter::Area { radiance, shape, .. }) = (lp.area, &scene.emitters[lp.emitter as usize])
     else {
-        return None;
+        return Vec::new();
     };
     let n_y = light_normal(scene, *shape, lp.y, n_y);
     if u_rate >= rate(opts) {
-        return None;
+        return Vec::new();
     }
     if !faces(n_y, lp.y, x_j.p) {
-        return fail(stats);
+        stats.manifold_failures += 1;
+        return Vec::new();
     }
     let (q, first) = seed_line(scene, opts, x_j, lp.y, stats);
     if u_rate >= q {
-        return None;
+        return Vec::new();
     }
-    let Some((sol, si_k)) = resolve(scene, x_j, lp.y, first, stats) else { return fail(stats) };
-    let to_y = lp.y - si_k.p;
-    let d_ky = to_y.length();
-    let omega_l = to_y / d_ky;
-    let cos_y = -n_y.dot(omega_l);
-    if !(cos_y > 0.0) {
-        return fail(stats); // the back of a one-sided emitter
+    let solutions = resolve(scene, x_j, lp.y, first, stats);
+    if solutions.is_empty() {
+        stats.manifold_failures += 1;
     }
-    let ds =
-        DirectionSample { p: lp.y, n: n_y, uv, d: omega_l, dist: d_ky, pdf: 0.0, delta: false, emitter: lp.emitter };
-    let light = LightSample::hit(omega_l, lp.y, d_ky, scene.pdf_emitter_direction(si_k.p, &ds));
-    let tr = light_transmission(scene, &si_k, &light, stats);
-    let le = radiance.eval(uv);
-    if tr == Spectrum::ZERO || le == Spectrum::ZERO {
-        return fail(stats);
+    let mut out = Vec::with_capacity(solutions.len());
+    for (sol, si_k) in solutions {
+        let to_y = lp.y - si_k.p;
+        let d_ky = to_y.length();
+        let omega_l = to_y / d_ky;
+        let cos_y = -n_y.dot(omega_l);
+        if !(cos_y > 0.0) {
+            continue; // the back of a one-sided emitter
+        }
+        let ds = DirectionSample {
+            p: lp.y,
+            n: n_y,
+            uv,
+            d: omega_l,
+            dist: d_ky,
+            pdf: 0.0,
+            delta: false,
+            emitter: lp.emitter,
+        };
+        let light = LightSample::hit(omega_l, lp.y, d_ky, scene.pdf_emitter_direction(si_k.p, &ds));
+        let tr = light_transmission(scene, &si_k, &light, stats);
+        let le = radiance.eval(uv);
+        if tr == Spectrum::ZERO || le == Spectrum::ZERO {
+            continue;
+        }
+        stats.manifold_solutions += 1;
+        let m = &scene.media[x_j.medium as usize];
+        let omega = sol.omega.as_vec3().normalize();
+        let d_jk = si_k.t;
+        let eta = sol.patch.eta as f32;
+        let f = fresnel(sol.refracted.cos_out as f32, eta).0;
+        let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (q * lp.p_y);
+        let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
+        let p_man = q * mis::area_density(lp.p_y, sol.g, cos_y);
+        let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
+        let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
+        out.push(PointConnection { value, weight, si_k, omega, light });
     }
-    stats.manifold_solutions += 1;
-    let m = &scene.media[x_j.medium as usize];
-    let omega = sol.omega.as_vec3().normalize();
-    let d_jk = si_k.t;
-    let eta = sol.patch.eta as f32;
-    let f = fresnel(sol.refracted.cos_out as f32, eta).0;
-    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (q * lp.p_y);
-    let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
-    let p_man = q * mis::area_density(lp.p_y, sol.g, cos_y);
-    let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
-    let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
-    Some(PointConnection { value, weight, si_k, omega, light })
+    out
 }
 
-/// The connection's weighted contribution at `x_j` (with `beta`; `u_rate` uniform, [`connect`]),
-/// zero when it does not run or fails.
+/// The connection's weighted contribution at `x_j` (with `beta`; `u_rate` uniform, [`connect`]):
+/// the sum over the solutions it found, zero when it does not run or finds none.
 #[allow(clippy::too_many_arguments)]
 pub fn sample(
     scene: &Scene,
@@ -329,7 +332,7 @@ pub fn sample(
     stats: &mut LocalStats,
 ) -> Spectrum {
     let mut result = Spectrum::ZERO;
-    if let Some(c) = connect(scene, opts, x_i, x_j, lp, u_rate, channel, stats) {
+    for c in connect(scene, opts, x_i, x_j, lp, u_rate, channel, stats) {
         add_finite(&mut result, beta * c.value * c.weight as f32, stats);
     }
     result
