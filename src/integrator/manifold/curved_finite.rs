@@ -10,10 +10,10 @@
 //!
 //! **MIS with forward tracing and SNEE, unbiased without Bernoulli trials.** Forward tracing
 //! (phase sampling at `x_j`, refraction, the light hit) and SNEE make the same suffixes. Because
-//! the seed is a function of `(x_j, y)` only, the connection's density of ANY suffix
+//! the seeds are a function of `(x_j, y)` only, the connection's density of ANY suffix
 //! `x_j → x_k → y` is evaluable: `p_man = p_sel p_A(y) / (G |cos θ_y|)` (solid angle of `ω_jk` at
-//! `x_j`) if Newton from `seed(x_j, y)` converges to this `ω_jk` (verified as the technique
-//! verifies it), else 0 ([`density`], "re-solve from that path's seed"). Solutions the seed misses
+//! `x_j`) if Newton from the seed set `S(x_j, y)` finds this `ω_jk` (verified as the technique
+//! verifies it; every distinct solution found is one sample, their contributions summed), else 0 ([`density`], "re-solve from that path's seed"). Solutions the seed set misses
 //! have `p_man = 0`, and forward tracing (or SNEE) covers them with weight 1. The three-way power
 //! heuristic is `mis::env_weight`, computed from the same three densities at the three places
 //! that make such a suffix: the connection ([`sample`]), a forward path that left through the
