@@ -101,6 +101,8 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
 /// attempts and at least 20 connections with several solutions asserted did not finish within
 /// 15 minutes; with 100 attempts and at least 5 asserted it found 4 (31 suffixes, worst |Σw − 1|
 /// 8.0e-7) and failed the count; the attempts were then raised to 400, the count kept at 5.
+/// With 400 attempts: 24 such connections, but worst |Σw − 1| = 1.07e-3 (cos θ_y > 0.1): FAILS, an
+/// open defect (docs/manifold.md §8.2), not yet traced.
 #[test]
 #[ignore]
 fn technique_weights_sum_to_one_on_the_statue_with_several_solutions() {
