@@ -246,7 +246,7 @@ fn connection_rate_out_of_range_is_an_error() {
     }
 }
 
-/// How often the connection's deterministic procedure (`newton_point::solve_from_seeds`) finds the
+/// How often the connection's deterministic procedure (`newton_point::solve_distinct`) finds the
 /// suffix a FORWARD path made, on the paper's statue under its sphere light
 /// (`scenes/paper/sphere_smooth_st34.xml`; σt from `STATUE_SIGMA_T`, default 34): a forward hit
 /// the procedure misses keeps MIS weight 1 (docs/manifold.md §8.2), a firefly of `L_e` ≈ 900.
@@ -254,8 +254,11 @@ fn connection_rate_out_of_range_is_an_error() {
 /// centre), directions uniform in the cone of half-angle 70° around the light's centre, traced to
 /// the boundary, refracted about the interpolated normal in closed form, and kept when the
 /// refracted ray hits the light's front; each such suffix weighs `e^{−σt d_jk}`. Printed per
-/// number of seeds: the weighted share of suffixes the procedure finds, and its mean solves and
-/// rays per call. Ignored: a measurement (~1 min), no assertion.
+/// seed set (the first seed; chains of 2–4 refracted seeds; the first and a ring of 8; the exact
+/// forward direction, which shows every suffix is reachable; the procedure itself): the weighted
+/// share of suffixes whose solution is among the set's distinct solutions, and its mean solves and
+/// rays per call; and the first seed's misses by cause (no seed, another solution, lost, not
+/// converged). Ignored: a measurement (4–15 min on the shared machine), no assertion.
 #[test]
 #[ignore]
 fn diagnose_statue_forward_suffixes_found() {

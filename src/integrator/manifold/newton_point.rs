@@ -173,7 +173,7 @@ pub fn solve_point(
     Err((Failure::NoConvergence, MAX_ITERATIONS))
 }
 
-/// [`point_seed`] then [`solve_point`]: the first seed of [`solve_from_seeds`]. `Err((Lost, 0))`
+/// [`point_seed`] then [`solve_point`]: the first seed of [`solve_distinct`]. `Err((Lost, 0))`
 /// when there is no seed.
 pub fn solve_from_seed(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> Result<PointSolution, (Failure, u32)> {
     let seed = point_seed(locate, x_j, y).ok_or((Failure::Lost, 0))?;
