@@ -85,7 +85,7 @@ fn sphere_light_through_matched_pebble_agrees_with_null_boundary() {
 fn technique_weights_sum_to_one_on_sampled_suffixes() {
     let scene = scene(&mesh("volpath_snee", COMPLETE, GLASS, "pebble.ply"), &[]);
     let mut rng = snee::sampler::Sampler::new(17, 1);
-    weights_sum_to_one(&scene, 400, |_| {
+    weights_sum_to_one(&scene, 400, 1e-6, |_| {
         let mut u3 = || Vec3::new(rng.next_1d(), rng.next_1d(), rng.next_1d()) - Vec3::splat(0.5);
         let x_i = u3() * 0.4;
         (x_i, x_i + u3() * 0.3)
@@ -101,8 +101,14 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
 /// attempts and at least 20 connections with several solutions asserted did not finish within
 /// 15 minutes; with 100 attempts and at least 5 asserted it found 4 (31 suffixes, worst |Σw − 1|
 /// 8.0e-7) and failed the count; the attempts were then raised to 400, the count kept at 5.
-/// With 400 attempts: 24 such connections, but worst |Σw − 1| = 1.07e-3 (cos θ_y > 0.1): FAILS, an
-/// open defect (docs/manifold.md §8.2), not yet traced.
+/// With 400 attempts: 24 such connections, but worst |Σw − 1| = 1.07e-3 (cos θ_y > 0.1), one
+/// suffix whose SNEE weight left out the connection's density: SNEE rebuilds `x_j → x_k` from two
+/// f32 points, and with coordinates near 100 and `x_k` a few hundredths from `x_j` that direction
+/// lay farther than `SAME_SOLUTION` (1e-4 rad) from the solution. SNEE's look-up now allows the
+/// points' rounding (`curved_finite::direction_tolerance`) and every look-up takes the nearest
+/// solution: worst 4.6e-6 (cos θ_y > 0.1), 2.8e-6 (grazing), 4.5 minutes on the idle machine.
+/// The tolerance here is [`STATUE_ROUNDING`], not the pebble's 1e-6; a density left out still
+/// shows as ~1e-3.
 #[test]
 #[ignore]
 fn technique_weights_sum_to_one_on_the_statue_with_several_solutions() {
@@ -111,7 +117,7 @@ fn technique_weights_sum_to_one_on_the_statue_with_several_solutions() {
     let center = Vec3::new(28.6788, 81.9152, 49.6732);
     let mut rng = snee::sampler::Sampler::new(13, 1);
     let mut u = move || rng.next_1d() as f64;
-    let multi = weights_sum_to_one(&scene, 400, |_| loop {
+    let multi = weights_sum_to_one(&scene, 400, STATUE_ROUNDING, |_| loop {
         let x_j = inside_point(&scene, &mut u);
         let to_c = (center - x_j).normalize();
         let Some(si) = scene.ray_intersect(&Ray::new(x_j, to_c)) else { continue };
@@ -123,6 +129,11 @@ fn technique_weights_sum_to_one_on_the_statue_with_several_solutions() {
     });
     assert!(multi >= 5, "{multi} connections with several solutions on the statue");
 }
+
+/// The weights' tolerance on the statue: SNEE's direction rebuilt from f32 points ~100 units from
+/// the origin, `x_k` a few hundredths from `x_j`, turns by up to ~1e-4 rad, and its densities by up
+/// to ~1e-5 relative (the pebble, coordinates below 1, keeps 1e-6).
+const STATUE_ROUNDING: f64 = 1e-5;
 
 /// The paper's statue under its sphere light (`scenes/paper/sphere_smooth_st34.xml`) at `sigma_t`,
 /// `volpath_snee` with the integrator properties `props`.
@@ -141,6 +152,7 @@ fn statue_scene(sigma_t: f64, props: &str) -> snee::scene::world::Scene {
 fn weights_sum_to_one(
     scene: &snee::scene::world::Scene,
     attempts: u32,
+    tolerance: f64,
     mut vertices: impl FnMut(u32) -> (Vec3, Vec3),
 ) -> u32 {
     use snee::integrator::manifold::{curved_finite, finite, MediumVertex};
@@ -201,7 +213,7 @@ fn weights_sum_to_one(
     }
     eprintln!("{checked} suffixes ({hidden} with x_k hidden from x_i skipped, {missed} whose f32 ray missed the light), {shared} shared (no weight above 0.99), {multi} connections with several solutions; worst |Σw − 1| = {worst:.2e} (cos θ_y > 0.1), {worst_grazing:.2e} (grazing)");
     assert!(checked > attempts / 8 && shared > 5, "too few suffixes checked ({checked}, {shared} shared)");
-    assert!(worst < 1e-6 && worst_grazing < 1e-6, "weights sum to 1 ± {worst} (grazing ± {worst_grazing})");
+    assert!(worst < tolerance && worst_grazing < tolerance, "weights sum to 1 ± {worst} (grazing ± {worst_grazing})");
     multi
 }
 

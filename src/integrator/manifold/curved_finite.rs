@@ -198,8 +198,9 @@ fn faces(n_y: Vec3, y: Vec3, x_j: Vec3) -> bool {
 
 /// The connection's density of the suffix `x_j → x_k → y` that another technique made along
 /// `omega_jk`: re-solve from the path's own seed `(x_j, y)` and keep `q(x_j, y) p_sel p_A(y) / (G
-/// |cos θ_y|)` ([`rate_at`]) when Newton lands on this `omega_jk`, else 0 (and 0 when [`faces`] is false). `p_y`:
-/// `p_sel p_A(y)`; `n_y`, `cos_y` at `y`.
+/// |cos θ_y|)` ([`rate_at`]) when the set of solutions holds this `omega_jk` (the nearest solution within
+/// `tolerance` radians), else 0 (and 0 when [`faces`] is false). `p_y`: `p_sel p_A(y)`; `n_y`,
+/// `cos_y` at `y`.
 #[allow(clippy::too_many_arguments)]
 fn density(
     scene: &Scene,
@@ -210,6 +211,7 @@ fn density(
     n_y: Vec3,
     p_y: f64,
     cos_y: f32,
+    tolerance: f64,
     stats: &mut LocalStats,
 ) -> f64 {
     if !faces(n_y, y, x_j.p) {
@@ -218,7 +220,14 @@ fn density(
     stats.manifold_resolves += 1;
     let (q, first) = seed_line(scene, opts, x_j, y, stats);
     let solutions = resolve(scene, x_j, y, first, stats);
-    match solutions.iter().find(|(sol, _)| (sol.omega - omega_jk.as_dvec3()).length() < newton_point::SAME_SOLUTION) {
+    let w = omega_jk.as_dvec3();
+    let nearest = solutions
+        .iter()
+        .map(|s| ((s.0.omega - w).length(), s))
+        .filter(|(d, _)| *d < tolerance)
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, s)| s);
+    match nearest {
         Some((sol, _)) => {
             stats.manifold_resolve_matches += 1;
             q * mis::area_density(p_y, sol.g, cos_y)
@@ -394,11 +403,20 @@ pub fn forward_weight(
     let n_y = light_normal(scene, y.shape, y.p, y.n);
     let cos_y = n_y.dot(omega_l).abs();
     let d_jk = (p.si_k.p - p.x_j.p).length();
-    let p_man = density(scene, opts, &p.x_j, p.omega_jk, y.p, n_y, p_y, cos_y, stats);
+    let p_man = density(scene, opts, &p.x_j, p.omega_jk, y.p, n_y, p_y, cos_y, newton_point::SAME_SOLUTION, stats);
     let ds = scene.direction_sample_for_hit(p.si_k.p, y);
     let light = LightSample::hit(omega_l, y.p, ds.dist, scene.pdf_emitter_direction(p.si_k.p, &ds));
     let pd = pdfs(scene, opts, p.x_i.as_ref(), &p.x_j, &p.si_k, p.omega_jk, d_jk, &light, p_man, channel, true, stats);
     Some(mis::env_weight(opts, EnvTechnique::Forward, pd) as f32)
+}
+
+/// How far (radians) SNEE's direction `x_j → x_k`, rebuilt from two `f32` points, may lie from
+/// the `f64` solution it is: [`newton_point::SAME_SOLUTION`], or more when `x_k` is so close to
+/// `x_j` that the points' rounding (a few ulps of their coordinates) turns the direction by more.
+/// The look-up takes the nearest solution within it, so distinct solutions stay apart.
+fn direction_tolerance(s: &SneeSuffix, d_jk: f32) -> f64 {
+    let ulp = f32::EPSILON as f64 * (s.x_j.abs().max_element().max(s.si_k.p.abs().max_element())) as f64;
+    newton_point::SAME_SOLUTION.max(8.0 * ulp / d_jk as f64)
 }
 
 /// SNEE's weight for a suffix it made towards a point `light.p` of an area light through a curved
@@ -426,7 +444,8 @@ pub fn snee_weight(
     let v_jk = s.si_k.p - s.x_j;
     let d_jk = v_jk.length();
     let omega_jk = v_jk / d_jk;
-    let p_man = density(scene, opts, &x_j, omega_jk, light.p, n_y, p_y, cos_y, &mut no_stats);
+    let p_man =
+        density(scene, opts, &x_j, omega_jk, light.p, n_y, p_y, cos_y, direction_tolerance(s, d_jk), &mut no_stats);
     let p = pdfs(scene, opts, Some(&s.x_i), &x_j, &s.si_k, omega_jk, d_jk, light, p_man, channel, false, &mut no_stats);
     Some(mis::env_weight(opts, EnvTechnique::Snee, p))
 }
