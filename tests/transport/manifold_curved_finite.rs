@@ -15,6 +15,7 @@
 //! 12 × 256 (`complete`), as `manifold_finite.rs`; matched 12 × 64 each.
 
 use crate::common;
+use snee::math::{Ray, Vec3};
 
 use common::{render_batches, scene, welch_compare, GLASS, MATCHED};
 
@@ -82,57 +83,138 @@ fn sphere_light_through_matched_pebble_agrees_with_null_boundary() {
 /// every angle, grazing (`cos θ_y ≤ 0.1`) included (the worst of each printed).
 #[test]
 fn technique_weights_sum_to_one_on_sampled_suffixes() {
+    let scene = scene(&mesh("volpath_snee", COMPLETE, GLASS, "pebble.ply"), &[]);
+    let mut rng = snee::sampler::Sampler::new(17, 1);
+    weights_sum_to_one(&scene, 400, 1e-6, |_| {
+        let mut u3 = || Vec3::new(rng.next_1d(), rng.next_1d(), rng.next_1d()) - Vec3::splat(0.5);
+        let x_i = u3() * 0.4;
+        (x_i, x_i + u3() * 0.3)
+    });
+}
+
+/// The same on the paper's statue under its sphere light (σt 34), where the procedure's seeds find
+/// several distinct solutions at many vertices (each weighed at its three places). Medium vertices `x_j` uniform in the statue with
+/// optical depth below 3 towards the light's centre (where the connection finds solutions), `x_i`
+/// within 0.02 of it. (First tried on the non-convex blob of the tests above: 0 of 400 attempts
+/// found two solutions there.)
+/// Ignored: minutes on the shared machine (load ~10). History, for honesty: a first run with 400
+/// attempts and at least 20 connections with several solutions asserted did not finish within
+/// 15 minutes; with 100 attempts and at least 5 asserted it found 4 (31 suffixes, worst |Σw − 1|
+/// 8.0e-7) and failed the count; the attempts were then raised to 400, the count kept at 5.
+/// With 400 attempts: 24 such connections, but worst |Σw − 1| = 1.07e-3 (cos θ_y > 0.1), one
+/// suffix whose SNEE weight left out the connection's density: SNEE rebuilds `x_j → x_k` from two
+/// f32 points, and with coordinates near 100 and `x_k` a few hundredths from `x_j` that direction
+/// lay farther than `SAME_SOLUTION` (1e-4 rad) from the solution. SNEE's look-up now allows the
+/// points' rounding (`curved_finite::direction_tolerance`) and every look-up takes the nearest
+/// solution: worst 4.6e-6 (cos θ_y > 0.1), 2.8e-6 (grazing), 4.5 minutes on the idle machine.
+/// The tolerance here is [`STATUE_ROUNDING`], not the pebble's 1e-6; a density left out still
+/// shows as ~1e-3.
+#[test]
+#[ignore]
+fn technique_weights_sum_to_one_on_the_statue_with_several_solutions() {
+    use crate::manifold_curved_statue::inside_point;
+    let scene = statue_scene(34.0, COMPLETE);
+    let center = Vec3::new(28.6788, 81.9152, 49.6732);
+    let mut rng = snee::sampler::Sampler::new(13, 1);
+    let mut u = move || rng.next_1d() as f64;
+    let multi = weights_sum_to_one(&scene, 400, STATUE_ROUNDING, |_| loop {
+        let x_j = inside_point(&scene, &mut u);
+        let to_c = (center - x_j).normalize();
+        let Some(si) = scene.ray_intersect(&Ray::new(x_j, to_c)) else { continue };
+        if si.t * 34.0 > 3.0 {
+            continue;
+        }
+        let d = Vec3::new(u() as f32, u() as f32, u() as f32) - Vec3::splat(0.5);
+        return (x_j + d * 0.04, x_j);
+    });
+    assert!(multi >= 5, "{multi} connections with several solutions on the statue");
+}
+
+/// The weights' tolerance on the statue: SNEE's direction rebuilt from f32 points ~100 units from
+/// the origin, `x_k` a few hundredths from `x_j`, turns by up to ~1e-4 rad, and its densities by up
+/// to ~1e-5 relative (the pebble, coordinates below 1, keeps 1e-6).
+const STATUE_ROUNDING: f64 = 1e-5;
+
+/// The paper's statue under its sphere light (`scenes/paper/sphere_smooth_st34.xml`) at `sigma_t`,
+/// `volpath_snee` with the integrator properties `props`.
+fn statue_scene(sigma_t: f64, props: &str) -> snee::scene::world::Scene {
+    let xml = std::fs::read_to_string(common::root().join("scenes/paper/sphere_smooth_st34.xml")).unwrap();
+    let xml = xml
+        .replace(r#"<integrator type="$integrator">"#, &format!(r#"<integrator type="volpath_snee">{props}"#))
+        .replace(r#"value="statue.ply""#, r#"value="paper/statue.ply""#)
+        .replace(r#"<float name="sigma_t" value="34"/>"#, &format!(r#"<float name="sigma_t" value="{sigma_t}"/>"#));
+    common::scene(&xml, &[])
+}
+
+/// The check of the tests above on `scene` (its only emitter a sphere light), with `(x_i, x_j)`
+/// drawn by `vertices` (given the attempt's index); returns how many connections found several
+/// solutions.
+fn weights_sum_to_one(
+    scene: &snee::scene::world::Scene,
+    attempts: u32,
+    tolerance: f64,
+    mut vertices: impl FnMut(u32) -> (Vec3, Vec3),
+) -> u32 {
     use snee::integrator::manifold::{curved_finite, finite, MediumVertex};
     use snee::integrator::snee::SneeVertex;
     use snee::integrator::stats::LocalStats;
     use snee::interaction::{offset_origin, spawn_ray_between};
-    use snee::math::{Ray, Vec2, Vec3};
-    let scene = scene(&mesh("volpath_snee", COMPLETE, GLASS, "pebble.ply"), &[]);
+    use snee::math::{Ray, Vec2};
     let opts = scene.integrator.snee;
     let mut rng = snee::sampler::Sampler::new(11, 1);
+    let (mut multi, mut missed) = (0, 0);
     let mut stats = LocalStats::default();
     let (mut checked, mut shared, mut hidden, mut worst, mut worst_grazing) = (0, 0, 0, 0.0f64, 0.0f64);
-    for _ in 0..400 {
-        let mut u3 = || Vec3::new(rng.next_1d(), rng.next_1d(), rng.next_1d()) - Vec3::splat(0.5);
-        let x_i = SneeVertex { p: u3() * 0.4, wi: u3().normalize(), medium: 0, rate: 1.0 };
-        let p_j = x_i.p + u3() * 0.3;
+    for attempt in 0..attempts {
+        let (p_i, p_j) = vertices(attempt);
+        let wi = Vec3::new(rng.next_1d(), rng.next_1d(), rng.next_1d()) - Vec3::splat(0.5);
+        let x_i = SneeVertex { p: p_i, wi: wi.normalize(), medium: 0, rate: 1.0 };
         let x_j = MediumVertex { p: p_j, wi: (x_i.p - p_j).normalize(), medium: 0 };
-        let finite::Pick::Finite(lp) = finite::pick(&scene, Vec2::new(rng.next_1d(), rng.next_1d())) else {
+        let finite::Pick::Finite(lp) = finite::pick(scene, Vec2::new(rng.next_1d(), rng.next_1d())) else {
             panic!("the sphere light is the only emitter")
         };
-        let Some(c) = curved_finite::connect(&scene, opts, Some(&x_i), &x_j, &lp, 0.0, 0, &mut stats) else { continue };
-        // The forward path: the same suffix, the light hit along the refracted direction.
-        let omega_l = c.light.omega_l;
-        let mut hit =
-            scene.ray_intersect(&Ray::new(offset_origin(c.si_k.p, c.si_k.n, omega_l), omega_l)).expect("hits");
-        // The same suffix: the sampled point (the f32 hit differs from it by ~1e-6, which moves
-        // `G` by up to 1.6 % next to a caustic, a different path). The hit's own normal is kept:
-        // every side takes the sphere's normal from the light point (`curved_finite::light_normal`).
-        hit.p = lp.y;
-        let pending = curved_finite::Pending { x_i: Some(x_i), x_j, si_k: c.si_k, omega_jk: c.omega };
-        let w_fwd = curved_finite::forward_weight(&scene, opts, &pending, &hit, omega_l, 0, &mut stats).unwrap() as f64;
-        // SNEE makes the suffix only when x_k is visible from x_i (its probe's first hit); x_i can
-        // lie outside the inscribed mesh near its facets, and then SNEE's weight is not defined.
-        let inner_k = offset_origin(c.si_k.p, c.si_k.n, x_i.p - c.si_k.p);
-        if scene.ray_test(&spawn_ray_between(x_i.p, inner_k)) {
-            hidden += 1;
-            continue;
+        let connections = curved_finite::connect(scene, opts, Some(&x_i), &x_j, &lp, 0.0, 0, &mut stats);
+        multi += (connections.len() > 1) as u32;
+        for c in connections {
+            // The forward path: the same suffix, the light hit along the refracted direction.
+            let omega_l = c.light.omega_l;
+            // (On the statue the f32 ray from `x_k` can miss the small light at its rim: skipped, counted.)
+            let Some(mut hit) = scene.ray_intersect(&Ray::new(offset_origin(c.si_k.p, c.si_k.n, omega_l), omega_l))
+            else {
+                missed += 1;
+                continue;
+            };
+            // The same suffix: the sampled point (the f32 hit differs from it by ~1e-6, which moves
+            // `G` by up to 1.6 % next to a caustic, a different path). The hit's own normal is kept:
+            // every side takes the sphere's normal from the light point (`curved_finite::light_normal`).
+            hit.p = lp.y;
+            let pending = curved_finite::Pending { x_i: Some(x_i), x_j, si_k: c.si_k, omega_jk: c.omega };
+            let w_fwd =
+                curved_finite::forward_weight(scene, opts, &pending, &hit, omega_l, 0, &mut stats).unwrap() as f64;
+            // SNEE makes the suffix only when x_k is visible from x_i (its probe's first hit); x_i can
+            // lie outside the inscribed mesh near its facets, and then SNEE's weight is not defined.
+            let inner_k = offset_origin(c.si_k.p, c.si_k.n, x_i.p - c.si_k.p);
+            if scene.ray_test(&spawn_ray_between(x_i.p, inner_k)) {
+                hidden += 1;
+                continue;
+            }
+            let suffix = snee::integrator::snee::SneeSuffix { x_i, x_j: x_j.p, si_k: c.si_k };
+            let w_snee = curved_finite::snee_weight(scene, opts.technique, &suffix, &c.light, 0).unwrap();
+            let sum = c.weight + w_fwd + w_snee;
+            let cos_y = -lp.area.expect("an area light").0.dot(omega_l);
+            if cos_y > 0.1 {
+                worst = worst.max((sum - 1.0).abs());
+            } else {
+                worst_grazing = worst_grazing.max((sum - 1.0).abs());
+            }
+            checked += 1;
+            shared += (c.weight < 0.99 && (w_fwd > 0.01 || w_snee > 0.01)) as u32;
         }
-        let suffix = snee::integrator::snee::SneeSuffix { x_i, x_j: x_j.p, si_k: c.si_k };
-        let w_snee = curved_finite::snee_weight(&scene, opts.technique, &suffix, &c.light, 0).unwrap();
-        let sum = c.weight + w_fwd + w_snee;
-        let cos_y = -lp.area.expect("an area light").0.dot(omega_l);
-        if cos_y > 0.1 {
-            worst = worst.max((sum - 1.0).abs());
-        } else {
-            worst_grazing = worst_grazing.max((sum - 1.0).abs());
-        }
-        checked += 1;
-        shared += (c.weight < 0.99 && (w_fwd > 0.01 || w_snee > 0.01)) as u32;
     }
-    eprintln!("{checked} suffixes ({hidden} with x_k hidden from x_i skipped), {shared} shared (no weight above 0.99); worst |Σw − 1| = {worst:.2e} (cos θ_y > 0.1), {worst_grazing:.2e} (grazing)");
-    assert!(checked > 50 && shared > 5, "too few suffixes checked ({checked}, {shared} shared)");
-    assert!(worst < 1e-6 && worst_grazing < 1e-6, "weights sum to 1 ± {worst} (grazing ± {worst_grazing})");
+    eprintln!("{checked} suffixes ({hidden} with x_k hidden from x_i skipped, {missed} whose f32 ray missed the light), {shared} shared (no weight above 0.99), {multi} connections with several solutions; worst |Σw − 1| = {worst:.2e} (cos θ_y > 0.1), {worst_grazing:.2e} (grazing)");
+    assert!(checked > attempts / 8 && shared > 5, "too few suffixes checked ({checked}, {shared} shared)");
+    assert!(worst < tolerance && worst_grazing < tolerance, "weights sum to 1 ± {worst} (grazing ± {worst_grazing})");
+    multi
 }
 
 /// SNEE's default rate under `connection = complete` (docs/snee.md §5, `snee::rate::complete_rates`):
@@ -176,7 +258,7 @@ fn connection_rate_out_of_range_is_an_error() {
     }
 }
 
-/// How often the connection's deterministic procedure (`newton_point::solve_from_seeds`) finds the
+/// How often the connection's deterministic procedure (`newton_point::solve_distinct`) finds the
 /// suffix a FORWARD path made, on the paper's statue under its sphere light
 /// (`scenes/paper/sphere_smooth_st34.xml`; σt from `STATUE_SIGMA_T`, default 34): a forward hit
 /// the procedure misses keeps MIS weight 1 (docs/manifold.md §8.2), a firefly of `L_e` ≈ 900.
@@ -184,14 +266,20 @@ fn connection_rate_out_of_range_is_an_error() {
 /// centre), directions uniform in the cone of half-angle 70° around the light's centre, traced to
 /// the boundary, refracted about the interpolated normal in closed form, and kept when the
 /// refracted ray hits the light's front; each such suffix weighs `e^{−σt d_jk}`. Printed per
-/// number of seeds: the weighted share of suffixes the procedure finds, and its mean solves and
-/// rays per call. Ignored: a measurement (~1 min), no assertion.
+/// seed set (the first seed; chains of 2–4 refracted seeds; the first and a ring of 8; the exact
+/// forward direction, which shows every suffix is reachable; the procedure itself): the weighted
+/// share of suffixes whose solution is among the set's distinct solutions, and its mean solves and
+/// rays per call; and the first seed's misses by cause (no seed, another solution, lost, not
+/// converged). Ignored: a measurement (4–15 min on the shared machine), no assertion.
 #[test]
 #[ignore]
 fn diagnose_statue_forward_suffixes_found() {
     use crate::manifold_curved_statue::inside_point;
     use snee::integrator::manifold::locate::{boundary_patch, SceneLocate};
-    use snee::integrator::manifold::newton_point::{point_seed, solve_from_seeds};
+    use snee::integrator::manifold::newton::Failure;
+    use snee::integrator::manifold::newton_point::{
+        point_seed, refracted_seed_along, solve_distinct, solve_point, SEEDS,
+    };
     use snee::math::{DVec3, Ray, Vec3};
     let sigma_t: f64 = std::env::var("STATUE_SIGMA_T").ok().and_then(|s| s.parse().ok()).unwrap_or(34.0);
     let xml = std::fs::read_to_string(common::root().join("scenes/paper/sphere_smooth_st34.xml")).unwrap();
@@ -204,12 +292,18 @@ fn diagnose_statue_forward_suffixes_found() {
         .replace(r#"<float name="sigma_t" value="34"/>"#, &format!(r#"<float name="sigma_t" value="{sigma_t}"/>"#));
     let scene = common::scene(&xml, &[]);
     let center = Vec3::new(28.6788, 81.9152, 49.6732);
-    let variants = [1usize, 2, 6, 10];
+    // Seed sets, each tried in full (every distinct converged solution kept): the first seed; the
+    // chain of refracted seeds along the previous seed (`refracted_seed_along`); the first seed and
+    // a ring of 8 at 0.1 rad; the exact forward direction (reachability).
+    const SETS: usize = 7;
+    let names = ["first", "chain 2", "chain 3", "chain 4", "first + ring 8", "exact w (reach)", "procedure"];
     let mut rng = snee::sampler::Sampler::new(7, 1);
     let mut u = move || rng.next_1d() as f64;
-    let (mut total, mut hits) = (0.0f64, 0u32);
-    let mut found = [0.0f64; 4];
-    let mut cost = [(0u64, 0u64); 4];
+    let (mut total, mut hits, mut solutions) = (0.0f64, 0u32, 0u64);
+    let mut found = [0.0f64; SETS];
+    let mut cost = [(0u64, 0u64); SETS];
+    // The first seed's outcome on the suffixes it misses: no seed, another solution, lost, not converged.
+    let mut cause = [0.0f64; 4];
     let cos_max = 70f64.to_radians().cos();
     let mut vertices = 0;
     while vertices < 300 {
@@ -237,29 +331,96 @@ fn diagnose_statue_forward_suffixes_found() {
                 continue;
             }
             let y: DVec3 = hit.p.as_dvec3();
+            let x = x_j.as_dvec3();
             let weight = (-sigma_t * rf.t).exp();
             total += weight;
             hits += 1;
-            for (v, &n) in variants.iter().enumerate() {
+            for v in 0..SETS {
                 let mut locate = SceneLocate { scene: &scene, medium: 0, rays: 0 };
-                let mut solves = 0;
-                let first = point_seed(&mut locate, x_j.as_dvec3(), y);
-                let r = solve_from_seeds(&mut locate, x_j.as_dvec3(), y, first, n, &mut solves);
-                cost[v].0 += solves as u64;
+                let first = point_seed(&mut locate, x, y);
+                let mut seeds: Vec<DVec3> = Vec::new();
+                match v {
+                    0..=3 => {
+                        let mut s = first;
+                        for _ in 0..=v {
+                            let Some(d) = s else { break };
+                            seeds.push(d);
+                            s = refracted_seed_along(&mut locate, x, y, d);
+                        }
+                    }
+                    4 => {
+                        if let Some(f) = first {
+                            seeds.push(f);
+                            let t = snee::integrator::manifold::newton::tangents(f);
+                            for i in 0..8 {
+                                let a = i as f64 * std::f64::consts::FRAC_PI_4;
+                                seeds.push(snee::integrator::manifold::newton::moved(
+                                    f,
+                                    t,
+                                    0.1 * a.cos(),
+                                    0.1 * a.sin(),
+                                ));
+                            }
+                        }
+                    }
+                    _ => seeds.push(w),
+                }
+                if v == 6 {
+                    let d = solve_distinct(&mut locate, x, y, first, SEEDS);
+                    cost[v].0 += d.solves as u64;
+                    cost[v].1 += locate.rays;
+                    if d.solutions.iter().any(|s| (s.omega - w).length() < 1e-4) {
+                        found[v] += weight;
+                    }
+                    solutions += d.solutions.len() as u64;
+                    continue;
+                }
+                let mut sols: Vec<DVec3> = Vec::new();
+                let mut first_outcome = 0;
+                for (k, &sd) in seeds.iter().enumerate() {
+                    cost[v].0 += 1;
+                    let r = solve_point(&mut locate, x, y, sd);
+                    if k == 0 {
+                        first_outcome = match r {
+                            Ok(s) if (s.omega - w).length() < 1e-4 => 4,
+                            Ok(_) => 1,
+                            Err((Failure::Lost, _)) => 2,
+                            Err((Failure::NoConvergence, _)) => 3,
+                        };
+                    }
+                    if let Ok(s) = r {
+                        if sols.iter().all(|o| (*o - s.omega).length() >= 1e-4) {
+                            sols.push(s.omega);
+                        }
+                    }
+                }
                 cost[v].1 += locate.rays;
-                if matches!(r, Ok(s) if (s.omega - w).length() < 1e-4) {
+                if sols.iter().any(|o| (*o - w).length() < 1e-4) {
                     found[v] += weight;
+                }
+                if v == 0 && first_outcome != 4 {
+                    cause[if seeds.is_empty() { 0 } else { first_outcome }] += weight;
                 }
             }
         }
     }
     eprintln!("σt {sigma_t}: {vertices} vertices, {hits} forward suffixes reaching the light");
-    for (v, &n) in variants.iter().enumerate() {
+    for v in 0..SETS {
         eprintln!(
-            "seeds {n:2}: found {:.1} % of the weighted suffixes; {:.2} solves, {:.1} rays per call",
+            "{:>16}: found {:.1} % of the weighted suffixes; {:.2} solves, {:.1} rays per call",
+            names[v],
             100.0 * found[v] / total,
             cost[v].0 as f64 / hits as f64,
             cost[v].1 as f64 / hits as f64
         );
     }
+    eprintln!("procedure: {:.2} distinct solutions per call", solutions as f64 / hits as f64);
+    eprintln!(
+        "first seed's misses ({:.1} %): no seed {:.1} %, another solution {:.1} %, lost {:.1} %, not converged {:.1} %",
+        100.0 * cause.iter().sum::<f64>() / total,
+        100.0 * cause[0] / total,
+        100.0 * cause[1] / total,
+        100.0 * cause[2] / total,
+        100.0 * cause[3] / total
+    );
 }

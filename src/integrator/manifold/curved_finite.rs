@@ -10,10 +10,10 @@
 //!
 //! **MIS with forward tracing and SNEE, unbiased without Bernoulli trials.** Forward tracing
 //! (phase sampling at `x_j`, refraction, the light hit) and SNEE make the same suffixes. Because
-//! the seed is a function of `(x_j, y)` only, the connection's density of ANY suffix
+//! the seeds are a function of `(x_j, y)` only, the connection's density of ANY suffix
 //! `x_j → x_k → y` is evaluable: `p_man = p_sel p_A(y) / (G |cos θ_y|)` (solid angle of `ω_jk` at
-//! `x_j`) if Newton from `seed(x_j, y)` converges to this `ω_jk` (verified as the technique
-//! verifies it), else 0 ([`density`], "re-solve from that path's seed"). Solutions the seed misses
+//! `x_j`) if Newton from the seed set `S(x_j, y)` finds this `ω_jk` (verified as the technique
+//! verifies it; every distinct solution found is one sample, their contributions summed), else 0 ([`density`], "re-solve from that path's seed"). Solutions the seed set misses
 //! have `p_man = 0`, and forward tracing (or SNEE) covers them with weight 1. The three-way power
 //! heuristic is `mis::env_weight`, computed from the same three densities at the three places
 //! that make such a suffix: the connection ([`sample`]), a forward path that left through the
@@ -23,7 +23,6 @@
 use super::finite::{self, LightPoint};
 use super::locate::{boundary_patch, SceneLocate};
 use super::mis::{self, EnvPdfs, EnvTechnique};
-use super::newton::Failure;
 use super::newton_point::{self, PointSolution};
 use super::{add_finite, MediumVertex};
 use crate::bsdf::fresnel::fresnel;
@@ -92,49 +91,39 @@ fn seed_line(
     (rate_at(rate(opts), sigma_t, t0), first)
 }
 
-/// Two directions are the same solution when they differ by less than this (radians).
-const SAME_SOLUTION: f64 = 1e-4;
-
-/// The deterministic solve from `x_j` towards `y` (`first`: [`seed_line`]'s seed), verified in the renderer's precision (the f32
-/// hit along the solution is the enclosing boundary from inside, at the solved point with the
-/// solved shading normal, and `y` lies outside both normals there). Counts the Newton work.
+/// The deterministic procedure from `x_j` towards `y` (`first`: [`seed_line`]'s seed;
+/// [`newton_point::solve_distinct`]: every distinct solution from a fixed set of seeds), each
+/// solution verified in the renderer's precision (the f32 hit along it is the enclosing boundary
+/// from inside, at the solved point with the solved shading normal, and `y` lies outside both
+/// normals there); the verified ones. Counts the Newton work.
 fn resolve(
     scene: &Scene,
     x_j: &MediumVertex,
     y: Vec3,
     first: Option<DVec3>,
     stats: &mut LocalStats,
-) -> Option<(PointSolution, SurfaceInteraction)> {
+) -> Vec<(PointSolution, SurfaceInteraction)> {
     let mut locate = SceneLocate { scene, medium: x_j.medium, rays: 0 };
-    let mut solves = 0;
     let (p, y64) = (x_j.p.as_dvec3(), y.as_dvec3());
-    let r = newton_point::solve_from_seeds(&mut locate, p, y64, first, newton_point::SEEDS, &mut solves);
+    let d = newton_point::solve_distinct(&mut locate, p, y64, first, newton_point::SEEDS);
     stats.rays += locate.rays;
-    stats.manifold_newton_solves += solves as u64;
-    let sol = match r {
-        Ok(s) => {
-            stats.manifold_newton_iterations += s.iterations as u64;
-            s
-        }
-        Err((f, it)) => {
-            stats.manifold_newton_iterations += it as u64;
-            match f {
-                Failure::Lost => stats.manifold_newton_lost += 1,
-                Failure::NoConvergence => stats.manifold_newton_failures += 1,
-            }
-            return None;
-        }
+    stats.manifold_newton_solves += d.solves as u64;
+    stats.manifold_newton_iterations += d.iterations as u64;
+    stats.manifold_newton_lost += d.lost as u64;
+    stats.manifold_newton_failures += d.not_converged as u64;
+    let verify = |sol: PointSolution, stats: &mut LocalStats| {
+        let omega = sol.omega.as_vec3().normalize();
+        stats.rays += 1;
+        let si = scene.ray_intersect(&Ray::new(x_j.p, omega))?;
+        let to_y = y - si.p;
+        let ok = boundary_patch(scene, &si, x_j.medium, omega).is_some()
+            && si.n.dot(to_y) > 0.0
+            && si.sh_frame.n.dot(to_y) > 0.0
+            && (si.p.as_dvec3() - sol.refracted.x_k).length() <= 1e-3 * (1.0 + sol.refracted.t)
+            && si.sh_frame.n.as_dvec3().dot(sol.refracted.n_s) > 1.0 - 1e-4;
+        ok.then_some((sol, si))
     };
-    let omega = sol.omega.as_vec3().normalize();
-    stats.rays += 1;
-    let si = scene.ray_intersect(&Ray::new(x_j.p, omega))?;
-    let to_y = y - si.p;
-    let ok = boundary_patch(scene, &si, x_j.medium, omega).is_some()
-        && si.n.dot(to_y) > 0.0
-        && si.sh_frame.n.dot(to_y) > 0.0
-        && (si.p.as_dvec3() - sol.refracted.x_k).length() <= 1e-3 * (1.0 + sol.refracted.t)
-        && si.sh_frame.n.as_dvec3().dot(sol.refracted.n_s) > 1.0 - 1e-4;
-    ok.then_some((sol, si))
+    d.solutions.into_iter().filter_map(|sol| verify(sol, stats)).collect()
 }
 
 /// The densities of `x_j → x_k → y` (solid angle of `ω_jk` at `x_j`): the connection's `p_man`
@@ -209,8 +198,9 @@ fn faces(n_y: Vec3, y: Vec3, x_j: Vec3) -> bool {
 
 /// The connection's density of the suffix `x_j → x_k → y` that another technique made along
 /// `omega_jk`: re-solve from the path's own seed `(x_j, y)` and keep `q(x_j, y) p_sel p_A(y) / (G
-/// |cos θ_y|)` ([`rate_at`]) when Newton lands on this `omega_jk`, else 0 (and 0 when [`faces`] is false). `p_y`:
-/// `p_sel p_A(y)`; `n_y`, `cos_y` at `y`.
+/// |cos θ_y|)` ([`rate_at`]) when the set of solutions holds this `omega_jk` (the nearest solution within
+/// `tolerance` radians), else 0 (and 0 when [`faces`] is false). `p_y`: `p_sel p_A(y)`; `n_y`,
+/// `cos_y` at `y`.
 #[allow(clippy::too_many_arguments)]
 fn density(
     scene: &Scene,
@@ -221,6 +211,7 @@ fn density(
     n_y: Vec3,
     p_y: f64,
     cos_y: f32,
+    tolerance: f64,
     stats: &mut LocalStats,
 ) -> f64 {
     if !faces(n_y, y, x_j.p) {
@@ -228,12 +219,20 @@ fn density(
     }
     stats.manifold_resolves += 1;
     let (q, first) = seed_line(scene, opts, x_j, y, stats);
-    match resolve(scene, x_j, y, first, stats) {
-        Some((sol, _)) if (sol.omega - omega_jk.as_dvec3()).length() < SAME_SOLUTION => {
+    let solutions = resolve(scene, x_j, y, first, stats);
+    let w = omega_jk.as_dvec3();
+    let nearest = solutions
+        .iter()
+        .map(|s| ((s.0.omega - w).length(), s))
+        .filter(|(d, _)| *d < tolerance)
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, s)| s);
+    match nearest {
+        Some((sol, _)) => {
             stats.manifold_resolve_matches += 1;
             q * mis::area_density(p_y, sol.g, cos_y)
         }
-        _ => 0.0,
+        None => 0.0,
     }
 }
 
@@ -252,8 +251,9 @@ pub struct PointConnection {
 /// The connection at `x_j` to the area-light point `lp` (its `area` is `Some`), run with
 /// probability `q(x_j, y)` ([`rate_at`]: it runs when the uniform `u_rate` is below it; the straight
 /// line's ray is cast only when `u_rate` is below the top rate [`rate`]): solve from the
-/// deterministic seed, verify, value (divided by `q`), and MIS-weight against forward tracing and
-/// SNEE. Counts solutions and failures.
+/// deterministic seeds, verify, and value (divided by `q`) and MIS-weight against forward tracing
+/// and SNEE EVERY distinct solution found (their sum is the estimate: each suffix of the set is
+/// one sample of the technique, docs/manifold.md §8.2). Counts solutions and failures.
 #[allow(clippy::too_many_arguments)]
 pub fn connect(
     scene: &Scene,
@@ -264,58 +264,70 @@ pub fn connect(
     u_rate: f64,
     channel: usize,
     stats: &mut LocalStats,
-) -> Option<PointConnection> {
-    let fail = |stats: &mut LocalStats| {
-        stats.manifold_failures += 1;
-        None
-    };
+) -> Vec<PointConnection> {
     let (Some((n_y, uv)), SceneEmitter::Area { radiance, shape, .. }) = (lp.area, &scene.emitters[lp.emitter as usize])
     else {
-        return None;
+        return Vec::new();
     };
     let n_y = light_normal(scene, *shape, lp.y, n_y);
     if u_rate >= rate(opts) {
-        return None;
+        return Vec::new();
     }
     if !faces(n_y, lp.y, x_j.p) {
-        return fail(stats);
+        stats.manifold_failures += 1;
+        return Vec::new();
     }
     let (q, first) = seed_line(scene, opts, x_j, lp.y, stats);
     if u_rate >= q {
-        return None;
+        return Vec::new();
     }
-    let Some((sol, si_k)) = resolve(scene, x_j, lp.y, first, stats) else { return fail(stats) };
-    let to_y = lp.y - si_k.p;
-    let d_ky = to_y.length();
-    let omega_l = to_y / d_ky;
-    let cos_y = -n_y.dot(omega_l);
-    if !(cos_y > 0.0) {
-        return fail(stats); // the back of a one-sided emitter
+    let solutions = resolve(scene, x_j, lp.y, first, stats);
+    if solutions.is_empty() {
+        stats.manifold_failures += 1;
     }
-    let ds =
-        DirectionSample { p: lp.y, n: n_y, uv, d: omega_l, dist: d_ky, pdf: 0.0, delta: false, emitter: lp.emitter };
-    let light = LightSample::hit(omega_l, lp.y, d_ky, scene.pdf_emitter_direction(si_k.p, &ds));
-    let tr = light_transmission(scene, &si_k, &light, stats);
-    let le = radiance.eval(uv);
-    if tr == Spectrum::ZERO || le == Spectrum::ZERO {
-        return fail(stats);
+    let mut out = Vec::with_capacity(solutions.len());
+    for (sol, si_k) in solutions {
+        let to_y = lp.y - si_k.p;
+        let d_ky = to_y.length();
+        let omega_l = to_y / d_ky;
+        let cos_y = -n_y.dot(omega_l);
+        if !(cos_y > 0.0) {
+            continue; // the back of a one-sided emitter
+        }
+        let ds = DirectionSample {
+            p: lp.y,
+            n: n_y,
+            uv,
+            d: omega_l,
+            dist: d_ky,
+            pdf: 0.0,
+            delta: false,
+            emitter: lp.emitter,
+        };
+        let light = LightSample::hit(omega_l, lp.y, d_ky, scene.pdf_emitter_direction(si_k.p, &ds));
+        let tr = light_transmission(scene, &si_k, &light, stats);
+        let le = radiance.eval(uv);
+        if tr == Spectrum::ZERO || le == Spectrum::ZERO {
+            continue;
+        }
+        stats.manifold_solutions += 1;
+        let m = &scene.media[x_j.medium as usize];
+        let omega = sol.omega.as_vec3().normalize();
+        let d_jk = si_k.t;
+        let eta = sol.patch.eta as f32;
+        let f = fresnel(sol.refracted.cos_out as f32, eta).0;
+        let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (q * lp.p_y);
+        let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
+        let p_man = q * mis::area_density(lp.p_y, sol.g, cos_y);
+        let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
+        let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
+        out.push(PointConnection { value, weight, si_k, omega, light });
     }
-    stats.manifold_solutions += 1;
-    let m = &scene.media[x_j.medium as usize];
-    let omega = sol.omega.as_vec3().normalize();
-    let d_jk = si_k.t;
-    let eta = sol.patch.eta as f32;
-    let f = fresnel(sol.refracted.cos_out as f32, eta).0;
-    let geometric = ((1.0 - f) * eta * eta) as f64 * sol.g * cos_y as f64 / (q * lp.p_y);
-    let value = m.phase.eval(x_j.wi, omega) * m.transmittance(d_jk) * le * tr * geometric as f32;
-    let p_man = q * mis::area_density(lp.p_y, sol.g, cos_y);
-    let p = pdfs(scene, opts, x_i, x_j, &si_k, omega, d_jk, &light, p_man, channel, true, stats);
-    let weight = mis::env_weight(opts, EnvTechnique::Manifold, p);
-    Some(PointConnection { value, weight, si_k, omega, light })
+    out
 }
 
-/// The connection's weighted contribution at `x_j` (with `beta`; `u_rate` uniform, [`connect`]),
-/// zero when it does not run or fails.
+/// The connection's weighted contribution at `x_j` (with `beta`; `u_rate` uniform, [`connect`]):
+/// the sum over the solutions it found, zero when it does not run or finds none.
 #[allow(clippy::too_many_arguments)]
 pub fn sample(
     scene: &Scene,
@@ -329,7 +341,7 @@ pub fn sample(
     stats: &mut LocalStats,
 ) -> Spectrum {
     let mut result = Spectrum::ZERO;
-    if let Some(c) = connect(scene, opts, x_i, x_j, lp, u_rate, channel, stats) {
+    for c in connect(scene, opts, x_i, x_j, lp, u_rate, channel, stats) {
         add_finite(&mut result, beta * c.value * c.weight as f32, stats);
     }
     result
@@ -391,11 +403,20 @@ pub fn forward_weight(
     let n_y = light_normal(scene, y.shape, y.p, y.n);
     let cos_y = n_y.dot(omega_l).abs();
     let d_jk = (p.si_k.p - p.x_j.p).length();
-    let p_man = density(scene, opts, &p.x_j, p.omega_jk, y.p, n_y, p_y, cos_y, stats);
+    let p_man = density(scene, opts, &p.x_j, p.omega_jk, y.p, n_y, p_y, cos_y, newton_point::SAME_SOLUTION, stats);
     let ds = scene.direction_sample_for_hit(p.si_k.p, y);
     let light = LightSample::hit(omega_l, y.p, ds.dist, scene.pdf_emitter_direction(p.si_k.p, &ds));
     let pd = pdfs(scene, opts, p.x_i.as_ref(), &p.x_j, &p.si_k, p.omega_jk, d_jk, &light, p_man, channel, true, stats);
     Some(mis::env_weight(opts, EnvTechnique::Forward, pd) as f32)
+}
+
+/// How far (radians) SNEE's direction `x_j → x_k`, rebuilt from two `f32` points, may lie from
+/// the `f64` solution it is: [`newton_point::SAME_SOLUTION`], or more when `x_k` is so close to
+/// `x_j` that the points' rounding (a few ulps of their coordinates) turns the direction by more.
+/// The look-up takes the nearest solution within it, so distinct solutions stay apart.
+fn direction_tolerance(s: &SneeSuffix, d_jk: f32) -> f64 {
+    let ulp = f32::EPSILON as f64 * (s.x_j.abs().max_element().max(s.si_k.p.abs().max_element())) as f64;
+    newton_point::SAME_SOLUTION.max(8.0 * ulp / d_jk as f64)
 }
 
 /// SNEE's weight for a suffix it made towards a point `light.p` of an area light through a curved
@@ -423,7 +444,8 @@ pub fn snee_weight(
     let v_jk = s.si_k.p - s.x_j;
     let d_jk = v_jk.length();
     let omega_jk = v_jk / d_jk;
-    let p_man = density(scene, opts, &x_j, omega_jk, light.p, n_y, p_y, cos_y, &mut no_stats);
+    let p_man =
+        density(scene, opts, &x_j, omega_jk, light.p, n_y, p_y, cos_y, direction_tolerance(s, d_jk), &mut no_stats);
     let p = pdfs(scene, opts, Some(&s.x_i), &x_j, &s.si_k, omega_jk, d_jk, light, p_man, channel, false, &mut no_stats);
     Some(mis::env_weight(opts, EnvTechnique::Snee, p))
 }

@@ -106,6 +106,23 @@ pub fn seed_line(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> (Option<f64>
     (Some(t0), Some((tangential + n_s * cos_in).normalize()))
 }
 
+/// The refracted seed along the direction `d` from `x_j` (one ray cast): at the boundary hit
+/// `x_k` of `d` with shading normal `n_s`, the direction `y − x_k` refracted into the medium and
+/// reversed ([`seed_line`]'s construction at another boundary point). `None` when `d` does not meet
+/// the enclosing boundary from inside or `y` is behind `n_s`.
+pub fn refracted_seed_along(locate: &mut impl Locate, x_j: DVec3, y: DVec3, d: DVec3) -> Option<DVec3> {
+    let patch = locate.locate(x_j, d)?;
+    let (_, x_k, n_s) = patch.hit(x_j, d)?;
+    let omega_l = (y - x_k).normalize();
+    let cos_l = omega_l.dot(n_s);
+    if !(cos_l > 0.0) {
+        return None;
+    }
+    let tangential = (omega_l - n_s * cos_l) / patch.eta;
+    let cos_in = (1.0 - tangential.length_squared()).max(0.0).sqrt();
+    Some((tangential + n_s * cos_in).normalize())
+}
+
 /// The deterministic seed for the light point `y`: [`seed_line`]'s.
 pub fn point_seed(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> Option<DVec3> {
     seed_line(locate, x_j, y).1
@@ -156,71 +173,86 @@ pub fn solve_point(
     Err((Failure::NoConvergence, MAX_ITERATIONS))
 }
 
-/// [`point_seed`] then [`solve_point`]: the first seed of [`solve_from_seeds`]. `Err((Lost, 0))`
+/// [`point_seed`] then [`solve_point`]: the first seed of [`solve_distinct`]. `Err((Lost, 0))`
 /// when there is no seed.
 pub fn solve_from_seed(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> Result<PointSolution, (Failure, u32)> {
     let seed = point_seed(locate, x_j, y).ok_or((Failure::Lost, 0))?;
     solve_point(locate, x_j, y, seed)
 }
 
-/// How many seeds the connection's deterministic procedure ([`solve_from_seeds`]) tries: only
-/// [`point_seed`]'s. Fallback seeds (the straight direction towards `y`, rings around the first
-/// seed) were measured on the statue under its sphere light and not kept: of the suffixes forward
-/// tracing makes (weighted by `e^{−σt d_jk}`), 1 seed finds 66.2 %, 2 seeds 66.8 %, 6 seeds 73.2 %
-/// at twice the rays per call (docs/manifold.md §8.2, "Fallback seeds";
-/// `tests/transport/manifold_curved_finite.rs`, `diagnose_statue_forward_suffixes_found`).
-pub const SEEDS: usize = 1;
-/// Angular radius (radians) of the ring of fallback seeds around the first seed.
+/// How many seeds the connection's deterministic procedure ([`solve_distinct`]) follows along the
+/// chain of refracted seeds: the first is [`point_seed`]'s, each next one the refracted seed along
+/// the previous ([`refracted_seed_along`]).
+pub const CHAIN_SEEDS: usize = 4;
+/// How many seeds of [`solve_distinct`] lie on a ring of angular radius [`RING`] around the first
+/// seed (after the chain).
+pub const RING_SEEDS: usize = 8;
+/// All seeds of the procedure.
+pub const SEEDS: usize = CHAIN_SEEDS + RING_SEEDS;
+/// Angular radius (radians) of the ring of seeds around the first seed.
 pub const RING: f64 = 0.1;
 
-/// The `k`-th seed of [`solve_from_seeds`] (`first`: [`point_seed`]'s, `d0`: the unit direction
-/// `x_j → y`): `first`, `d0`, then rings of 4 at [`RING`], 2 [`RING`], … around `first` (around `d0`
-/// when there is no `first`), each ring turned by 45° from the last.
-fn fallback_seed(k: usize, first: Option<DVec3>, d0: DVec3) -> Option<DVec3> {
-    match k {
-        0 => first,
-        1 => Some(d0),
-        _ => {
-            let c = first.unwrap_or(d0);
-            let (ring, i) = ((k - 2) / 4, (k - 2) % 4);
-            let radius = RING * (1 + ring) as f64;
-            let phi = (2 * i + ring % 2) as f64 * std::f64::consts::FRAC_PI_4;
-            Some(moved(c, tangents(c), radius * phi.cos(), radius * phi.sin()))
-        }
-    }
+/// Two directions are the same solution when they differ by less than this (radians).
+pub const SAME_SOLUTION: f64 = 1e-4;
+
+/// What [`solve_distinct`] found: every distinct converged solution, and the Newton work.
+#[derive(Clone, Debug, Default)]
+pub struct Distinct {
+    pub solutions: Vec<PointSolution>,
+    /// Newton solves started, iterations spent in all.
+    pub solves: u32,
+    pub iterations: u32,
+    /// Solves that failed, by cause.
+    pub lost: u32,
+    pub not_converged: u32,
 }
 
-/// The connection's deterministic procedure (docs/manifold.md §8.2): Newton ([`solve_point`])
-/// from each of the first `max_seeds` seeds of [`fallback_seed`] in turn (`first`: [`seed_line`]'s
-/// seed, computed by the caller), the first that
-/// converges giving the solution. A function of `(x_j, y)` only, so the technique's density of a
-/// given suffix is evaluable by running it again. Returns the iterations spent in all; `solves`
-/// counts the Newton solves started.
-pub fn solve_from_seeds(
+/// The connection's deterministic procedure (docs/manifold.md §8.2, "Several solutions per
+/// vertex"): Newton ([`solve_point`]) from each of `max_seeds` seeds — the chain of [`CHAIN_SEEDS`]
+/// refracted seeds starting at `first` ([`seed_line`]'s seed, computed by the caller), each
+/// the refracted seed along the previous one, then [`RING_SEEDS`] seeds on a ring of radius
+/// [`RING`] around `first` — keeping every DISTINCT converged solution (directions apart by
+/// [`SAME_SOLUTION`] or more). A function of `(x_j, y)` only, so the set is evaluable for any
+/// suffix by running the procedure again; an estimator summing over the set is unbiased with
+/// density `q p_y / (G |cos θ_y|) · [the set holds the suffix]`. No seed at all without `first`.
+pub fn solve_distinct(
     locate: &mut impl Locate,
     x_j: DVec3,
     y: DVec3,
     first: Option<DVec3>,
     max_seeds: usize,
-    solves: &mut u32,
-) -> Result<PointSolution, (Failure, u32)> {
-    let d0 = (y - x_j).normalize();
-    let (mut failure, mut iterations) = (Failure::Lost, 0);
+) -> Distinct {
+    let mut out = Distinct::default();
+    let Some(first) = first else { return out };
+    let ring = tangents(first);
+    let mut chain = Some(first);
     for k in 0..max_seeds {
-        let Some(seed) = fallback_seed(k, first, d0) else { continue };
-        *solves += 1;
+        let seed = if k < CHAIN_SEEDS {
+            let Some(seed) = chain else { continue };
+            chain = if k + 1 < CHAIN_SEEDS { refracted_seed_along(locate, x_j, y, seed) } else { None };
+            seed
+        } else {
+            let phi = (k - CHAIN_SEEDS) as f64 * std::f64::consts::TAU / RING_SEEDS as f64;
+            moved(first, ring, RING * phi.cos(), RING * phi.sin())
+        };
+        out.solves += 1;
         match solve_point(locate, x_j, y, seed) {
-            Ok(mut s) => {
-                s.iterations += iterations;
-                return Ok(s);
+            Ok(s) => {
+                out.iterations += s.iterations;
+                if out.solutions.iter().all(|o| (o.omega - s.omega).length() >= SAME_SOLUTION) {
+                    out.solutions.push(s);
+                }
             }
             Err((f, it)) => {
-                failure = f;
-                iterations += it;
+                out.iterations += it;
+                match f {
+                    Failure::Lost => out.lost += 1,
+                    Failure::NoConvergence => out.not_converged += 1,
+                }
             }
         }
     }
-    Err((failure, iterations))
+    out
 }
 
 #[cfg(test)]
@@ -354,8 +386,7 @@ mod tests {
             // The procedure and its rate at (x_j, y): (q, the solution).
             let mut technique = |y: DVec3| {
                 let (t0, first) = seed_line(&mut ball, x_j, y);
-                let mut solves = 0;
-                (rate_at(0.2, 3.0, t0), solve_from_seeds(&mut ball, x_j, y, first, SEEDS, &mut solves))
+                (rate_at(0.2, 3.0, t0), solve_distinct(&mut ball, x_j, y, first, SEEDS))
             };
             let n_dir = 400_000u32;
             let mut integral = [0.0; 2];
@@ -372,16 +403,15 @@ mod tests {
                 if !(y.x > x0 && y.x < x1 && y.y > y0 && y.y < y1) {
                     continue;
                 }
-                let (q, Ok(s)) = technique(y) else { continue };
-                if (s.omega - w).length() > 1e-4 {
-                    continue;
-                }
+                let (q, d) = technique(y);
+                let Some(s) = d.solutions.iter().find(|s| (s.omega - w).length() < SAME_SOLUTION) else { continue };
                 let p = (1.0 / area) / (s.g * r.o.z);
                 integral[0] += p;
                 integral[1] += q * p;
             }
             let n_grid = 600;
             let mut found = [0.0; 2];
+            let mut most = 0;
             for a in 0..n_grid {
                 for b in 0..n_grid {
                     let y = DVec3::new(
@@ -389,17 +419,17 @@ mod tests {
                         y0 + (y1 - y0) * (b as f64 + 0.5) / n_grid as f64,
                         hgt,
                     );
-                    let (q, r) = technique(y);
-                    if r.is_ok() {
-                        found[0] += 1.0;
-                        found[1] += q;
-                    }
+                    let (q, d) = technique(y);
+                    let n = d.solutions.len() as f64;
+                    found[0] += n;
+                    found[1] += q * n;
+                    most = most.max(d.solutions.len());
                 }
             }
             for k in 0..2 {
                 let integral = integral[k] * 4.0 * std::f64::consts::PI / n_dir as f64;
                 let p_found = found[k] / (n_grid * n_grid) as f64;
-                eprintln!("eta {eta}, rate {k}: ∫ p_man dω = {integral:.5}, P(solution, runs) = {p_found:.5}");
+                eprintln!("eta {eta}, rate {k}: ∫ p_man dω = {integral:.5}, E[q · solutions] = {p_found:.5} (at most {most} per y)");
                 assert!(p_found > [0.5, 0.01][k], "the seed should usually converge here");
                 assert!((integral / p_found - 1.0).abs() < 1e-2, "eta {eta}: {integral} vs {p_found}");
             }
