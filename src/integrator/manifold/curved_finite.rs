@@ -31,7 +31,7 @@ use crate::color::Spectrum;
 use crate::integrator::snee::light::light_transmission;
 use crate::integrator::snee::{passable, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
 use crate::integrator::stats::LocalStats;
-use crate::interaction::{DirectionSample, SurfaceInteraction};
+use crate::interaction::SurfaceInteraction;
 use crate::math::{DVec3, Ray, Vec3};
 use crate::scene::world::{Scene, SceneEmitter};
 use crate::shape::Geometry;
@@ -294,16 +294,7 @@ pub fn connect(
         if !(cos_y > 0.0) {
             continue; // the back of a one-sided emitter
         }
-        let ds = DirectionSample {
-            p: lp.y,
-            n: n_y,
-            uv,
-            d: omega_l,
-            dist: d_ky,
-            pdf: 0.0,
-            delta: false,
-            emitter: lp.emitter,
-        };
+        let ds = lp.direction_sample(n_y, uv, omega_l, d_ky);
         let light = LightSample::hit(omega_l, lp.y, d_ky, scene.pdf_emitter_direction(si_k.p, &ds));
         let tr = light_transmission(scene, &si_k, &light, stats);
         let le = radiance.eval(uv);

@@ -37,6 +37,14 @@ pub struct LightPoint {
     pub p_y: f64,
 }
 
+impl LightPoint {
+    /// The emitter's direction record for the area-light point `y` seen from a point at distance
+    /// `dist` along `d` (normal `n` and texture coordinates `uv` at `y`), to evaluate its density.
+    pub fn direction_sample(&self, n: Vec3, uv: Vec2, d: Vec3, dist: f32) -> DirectionSample {
+        DirectionSample { p: self.y, n, uv, d, dist, pdf: 0.0, delta: false, emitter: self.emitter }
+    }
+}
+
 /// What the emitter sample of the connection picked.
 #[derive(Clone, Copy, Debug)]
 pub enum Pick {
@@ -137,16 +145,7 @@ pub fn connect(
             if !(cos_y > 0.0) {
                 return fail(stats); // the back of a one-sided emitter
             }
-            let ds = DirectionSample {
-                p: lp.y,
-                n: n_y,
-                uv,
-                d: omega_l,
-                dist: d_ky,
-                pdf: 0.0,
-                delta: false,
-                emitter: lp.emitter,
-            };
+            let ds = lp.direction_sample(n_y, uv, omega_l, d_ky);
             let le = radiance.eval(uv) * (g * cos_y as f64 / lp.p_y) as f32;
             (le, cos_y, scene.pdf_emitter_direction(si_k.p, &ds))
         }

@@ -260,12 +260,19 @@ pub fn refracted_seed(locate: &mut impl Locate, x_j: DVec3, omega_l: DVec3) -> O
     let omega_l = omega_l.normalize();
     let patch = locate.locate(x_j, omega_l)?;
     let (_, _, n_s) = patch.hit(x_j, omega_l)?;
+    seed_from_light(omega_l, n_s, patch.eta)
+}
+
+/// The seed direction at a boundary point with shading normal `n_s` (outwards) and relative index
+/// `eta` for the light direction `omega_l` (unit, outwards): the inner direction, pointing at the
+/// boundary from inside, that refracts out along `omega_l`. `None` when the light is behind `n_s`.
+pub fn seed_from_light(omega_l: DVec3, n_s: DVec3, eta: f64) -> Option<DVec3> {
     let cos_l = omega_l.dot(n_s);
     if !(cos_l > 0.0) {
         return None;
     }
     // η_ext sin θ_l = η_int sin θ_in: the tangential part shrinks by 1/η.
-    let tangential = (omega_l - n_s * cos_l) / patch.eta;
+    let tangential = (omega_l - n_s * cos_l) / eta;
     let cos_in = (1.0 - tangential.length_squared()).max(0.0).sqrt();
     Some((tangential + n_s * cos_in).normalize())
 }

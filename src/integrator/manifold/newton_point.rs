@@ -113,14 +113,7 @@ pub fn seed_line(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> (Option<f64>
 pub fn refracted_seed_along(locate: &mut impl Locate, x_j: DVec3, y: DVec3, d: DVec3) -> Option<DVec3> {
     let patch = locate.locate(x_j, d)?;
     let (_, x_k, n_s) = patch.hit(x_j, d)?;
-    let omega_l = (y - x_k).normalize();
-    let cos_l = omega_l.dot(n_s);
-    if !(cos_l > 0.0) {
-        return None;
-    }
-    let tangential = (omega_l - n_s * cos_l) / patch.eta;
-    let cos_in = (1.0 - tangential.length_squared()).max(0.0).sqrt();
-    Some((tangential + n_s * cos_in).normalize())
+    super::newton::seed_from_light((y - x_k).normalize(), n_s, patch.eta)
 }
 
 /// The deterministic seed for the light point `y`: [`seed_line`]'s.
