@@ -83,14 +83,13 @@ fn curved_glass_blob_techniques_agree() {
 #[test]
 #[ignore]
 fn diagnose_statue_one_refraction_against_cone() {
-    use snee::bsdf::fresnel::fresnel;
+    use crate::manifold_curved_cone::{connection_mean, one_refraction};
     use snee::color::Spectrum;
-    use snee::integrator::manifold::locate::{boundary_patch, SceneLocate};
+    use snee::integrator::manifold::locate::SceneLocate;
     use snee::integrator::manifold::newton;
     use snee::integrator::manifold::{curved, MediumVertex};
     use snee::integrator::stats::LocalStats;
-    use snee::interaction::offset_origin;
-    use snee::math::{Ray, Vec3};
+    use snee::math::Vec3;
     use snee::sampler::Sampler;
 
     let env = |k: &str, d: usize| std::env::var(k).ok().and_then(|s| s.parse().ok()).unwrap_or(d);
@@ -99,10 +98,8 @@ fn diagnose_statue_one_refraction_against_cone() {
     let (ds, _) = scene.sample_emitter_direction(Vec3::ZERO, None, snee::math::Vec2::new(0.5, 0.5), false);
     let omega_l = ds.d;
     let od = omega_l.as_dvec3();
-    let m = &scene.media[0];
     let wi = Vec3::Z; // isotropic phase: wi does not matter
     let turn = newton::max_turn(curved::largest_eta(&scene, 0));
-    let omega_turn = std::f64::consts::TAU * (1.0 - turn.cos());
     let thetas = [0.02f64, 0.01];
     let cones = thetas.map(|t| std::f64::consts::TAU * (1.0 - t.cos()));
     let (points, n_dirs, runs) = (env("STATUE_POINTS", 12), 1u64 << env("STATUE_DIRS", 22), 4096);
@@ -125,26 +122,8 @@ fn diagnose_statue_one_refraction_against_cone() {
         let mut vsplit = [0.0f64; 3];
         let mut vsq = 0.0f64; // second moment of the verified part (its standard error)
         for _ in 0..n_dirs {
-            let w = newton::cone_seed(od, turn, u(), u());
-            let d = w.as_vec3();
-            let Some(si) = scene.ray_intersect(&Ray::new(p, d)) else { continue };
-            let Some(patch) = boundary_patch(&scene, &si, 0, d) else { continue };
-            let Some(r) = patch.refract(xd, w) else { continue };
-            let cos_o = r.o.dot(od);
-            if cos_o < thetas[0].cos() {
-                continue;
-            }
-            let o = r.o.as_vec3();
-            if scene.ray_intersect(&Ray::new(offset_origin(si.p, si.n, o), o)).is_some() {
-                continue;
-            }
-            let f = fresnel(r.cos_out as f32, patch.eta as f32).0 as f64;
-            let g = m.phase.eval(wi, d) as f64
-                * (-(m.sigma_t[0] as f64) * r.t).exp()
-                * (1.0 - f)
-                * patch.eta
-                * patch.eta
-                * omega_turn;
+            let Some(s) = one_refraction(&scene, p, wi, od, turn, thetas[0].cos(), (u(), u())) else { continue };
+            let (w, cos_o, g) = (s.w, s.cos_o, s.g);
             for (i, c) in cones.iter().enumerate() {
                 if cos_o >= thetas[i].cos() {
                     sum[i] += g / c;
@@ -174,15 +153,7 @@ fn diagnose_statue_one_refraction_against_cone() {
         let cm = sum.map(|s| s / n);
         let cv = [0, 1].map(|i| (sq[i] / n - cm[i] * cm[i]).max(0.0) / n);
         let before = (stats.manifold_trials_capped, stats.manifold_solutions, stats.manifold_failures);
-        let (mut s, mut s2) = (0.0, 0.0);
-        for _ in 0..runs {
-            let v = curved::connect(&scene, &x_j, omega_l, Spectrum::ONE, &mut sampler, &mut stats)
-                .map_or(0.0, |c| c.value.x as f64);
-            s += v;
-            s2 += v * v;
-        }
-        let mean = s / runs as f64;
-        let var = (s2 / runs as f64 - mean * mean).max(0.0) / runs as f64;
+        let (mean, var) = connection_mean(&scene, &x_j, omega_l, runs, &mut sampler, &mut stats);
         let vvar = (vsq / n - vsplit[0] * vsplit[0]).max(0.0) / n;
         diffs.push((mean - cm[1], mean - vsplit[0]));
         verified_v += vvar;
@@ -222,7 +193,7 @@ fn diagnose_statue_one_refraction_against_cone() {
         split[1],
         split[2],
         stats.manifold_trials_capped,
-        points * runs,
+        points * runs as usize,
     );
     // Paired over vertices: the spread of the per-vertex differences (it includes the cone's
     // finite-θ error, which differs from vertex to vertex: near-misses at folds read low, the

@@ -35,8 +35,9 @@ use snee::integrator::manifold::newton;
 use snee::integrator::manifold::{curved, MediumVertex};
 use snee::integrator::stats::LocalStats;
 use snee::interaction::offset_origin;
-use snee::math::{Ray, Vec3};
+use snee::math::{DVec3, Ray, Vec3};
 use snee::sampler::Sampler;
+use snee::scene::world::Scene;
 
 fn mesh_scene(file: &str) -> String {
     format!(
@@ -53,14 +54,81 @@ fn mesh_scene(file: &str) -> String {
     )
 }
 
+/// A direction kept by [`one_refraction`].
+pub(crate) struct ConeSample {
+    /// The direction at `p` and the cosine between the refracted direction and `omega_l`.
+    pub w: DVec3,
+    pub cos_o: f64,
+    /// Phase function, transmittance, `(1 − F) η²`, over the density of `w` (the cone's solid
+    /// angle): divided by a light cone's solid angle it estimates that cone's limit.
+    pub g: f64,
+}
+
+/// One direction of the Newton-free one-refraction reference at `p` (medium 0): `w` uniform in the
+/// cone of half-angle `turn` around `omega_l` (every solution lies there), refracted out where it
+/// meets the boundary; kept when the refracted direction `o` is within `cos_min` of `omega_l` and
+/// its light segment is free (a refracted ray that meets the mesh again is not a one-refraction
+/// path).
+pub(crate) fn one_refraction(
+    scene: &Scene,
+    p: Vec3,
+    wi: Vec3,
+    omega_l: DVec3,
+    turn: f64,
+    cos_min: f64,
+    u: (f64, f64),
+) -> Option<ConeSample> {
+    let m = &scene.media[0];
+    let omega_turn = std::f64::consts::TAU * (1.0 - turn.cos());
+    let w = newton::cone_seed(omega_l, turn, u.0, u.1);
+    let d = w.as_vec3();
+    let si = scene.ray_intersect(&Ray::new(p, d))?;
+    let patch = boundary_patch(scene, &si, 0, d)?;
+    let r = patch.refract(p.as_dvec3(), w)?;
+    let cos_o = r.o.dot(omega_l);
+    if cos_o < cos_min {
+        return None;
+    }
+    let o = r.o.as_vec3();
+    if scene.ray_intersect(&Ray::new(offset_origin(si.p, si.n, o), o)).is_some() {
+        return None;
+    }
+    let f = fresnel(r.cos_out as f32, patch.eta as f32).0 as f64;
+    let g = m.phase.eval(wi, d) as f64
+        * (-(m.sigma_t[0] as f64) * r.t).exp()
+        * (1.0 - f)
+        * patch.eta
+        * patch.eta
+        * omega_turn;
+    Some(ConeSample { w, cos_o, g })
+}
+
+/// The mean of `runs` connections `curved::connect` makes at `x_j` to the directional light along
+/// `omega_l` (first channel, 0 where it finds nothing), and the variance of that mean.
+pub(crate) fn connection_mean(
+    scene: &Scene,
+    x_j: &MediumVertex,
+    omega_l: Vec3,
+    runs: u32,
+    sampler: &mut Sampler,
+    stats: &mut LocalStats,
+) -> (f64, f64) {
+    let (mut s, mut s2) = (0.0, 0.0);
+    for _ in 0..runs {
+        let v = curved::connect(scene, x_j, omega_l, Spectrum::ONE, sampler, stats).map_or(0.0, |c| c.value.x as f64);
+        s += v;
+        s2 += v * v;
+    }
+    let mean = s / runs as f64;
+    (mean, (s2 / runs as f64 - mean * mean).max(0.0) / runs as f64)
+}
+
 fn cone_limit_agrees(file: &str, seed: u64) {
     let scene = common::scene(&mesh_scene(file), &[]);
     let omega_l = -Vec3::new(-0.3, -0.2, -0.9).normalize();
-    let m = &scene.media[0];
     let theta: f64 = 0.01;
     // Directions uniform in the cone of largest turn around omega_l (every solution lies there).
     let turn = newton::max_turn(1.5);
-    let omega_turn = std::f64::consts::TAU * (1.0 - turn.cos());
     let cone = std::f64::consts::TAU * (1.0 - theta.cos());
     let mut rng = Sampler::new(seed, 1);
     let mut u = move || rng.next_1d() as f64;
@@ -77,28 +145,10 @@ fn cone_limit_agrees(file: &str, seed: u64) {
         let n_dirs = 1u64 << 22;
         let (mut sum, mut sq) = (0.0, 0.0);
         for _ in 0..n_dirs {
-            let w = newton::cone_seed(omega_l.as_dvec3(), turn, u(), u());
-            let d = w.as_vec3();
-            let Some(si) = scene.ray_intersect(&Ray::new(p, d)) else { continue };
-            let Some(patch) = boundary_patch(&scene, &si, 0, d) else { continue };
-            let Some(r) = patch.refract(p.as_dvec3(), w) else { continue };
-            if r.o.dot(omega_l.as_dvec3()) < theta.cos() {
+            let Some(s) = one_refraction(&scene, p, wi, omega_l.as_dvec3(), turn, theta.cos(), (u(), u())) else {
                 continue;
-            }
-            // The light segment: a refracted ray that meets the (non-convex) mesh again is not
-            // a one-refraction path.
-            let o = r.o.as_vec3();
-            if scene.ray_intersect(&Ray::new(offset_origin(si.p, si.n, o), o)).is_some() {
-                continue;
-            }
-            let f = fresnel(r.cos_out as f32, patch.eta as f32).0 as f64;
-            let g = m.phase.eval(wi, d) as f64
-                * (-(m.sigma_t[0] as f64) * r.t).exp()
-                * (1.0 - f)
-                * patch.eta
-                * patch.eta
-                * omega_turn
-                / cone;
+            };
+            let g = s.g / cone;
             sum += g;
             sq += g * g;
         }
@@ -108,16 +158,8 @@ fn cone_limit_agrees(file: &str, seed: u64) {
             continue; // no light reaches x_j (behind the caustic's envelope): the next vertex
         }
         lit += 1;
-        let runs = 4096;
-        let (mut s, mut s2) = (0.0, 0.0);
-        for _ in 0..runs {
-            let v = curved::connect(&scene, &x_j, omega_l, Spectrum::ONE, &mut sampler, &mut stats)
-                .map_or(0.0, |c| c.value.x as f64);
-            s += v;
-            s2 += v * v;
-        }
-        let mean = s / runs as f64;
-        let se = ((s2 / runs as f64 - mean * mean).max(0.0) / runs as f64).sqrt();
+        let (mean, var) = connection_mean(&scene, &x_j, omega_l, 4096, &mut sampler, &mut stats);
+        let se = var.sqrt();
         let z = (mean - cone_mean) / (se * se + cone_se * cone_se).sqrt();
         eprintln!(
             "{file} x_j {p:?}: connection {mean:.6} ± {se:.6}, cone limit {cone_mean:.6} ± {cone_se:.6}, z {z:.2}"
