@@ -97,18 +97,13 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
 /// optical depth below 3 towards the light's centre (where the connection finds solutions), `x_i`
 /// within 0.02 of it. (First tried on the non-convex blob of the tests above: 0 of 400 attempts
 /// found two solutions there.)
-/// Ignored: minutes on the shared machine (load ~10). History, for honesty: a first run with 400
-/// attempts and at least 20 connections with several solutions asserted did not finish within
-/// 15 minutes; with 100 attempts and at least 5 asserted it found 4 (31 suffixes, worst |Σw − 1|
-/// 8.0e-7) and failed the count; the attempts were then raised to 400, the count kept at 5.
-/// With 400 attempts: 24 such connections, but worst |Σw − 1| = 1.07e-3 (cos θ_y > 0.1), one
-/// suffix whose SNEE weight left out the connection's density: SNEE rebuilds `x_j → x_k` from two
-/// f32 points, and with coordinates near 100 and `x_k` a few hundredths from `x_j` that direction
-/// lay farther than `SAME_SOLUTION` (1e-4 rad) from the solution. SNEE's look-up now allows the
-/// points' rounding (`curved_finite::direction_tolerance`) and every look-up takes the nearest
-/// solution: worst 4.6e-6 (cos θ_y > 0.1), 2.8e-6 (grazing), 4.5 minutes on the idle machine.
-/// The tolerance here is [`STATUE_ROUNDING`], not the pebble's 1e-6; a density left out still
-/// shows as ~1e-3.
+/// Ignored: 4.5 minutes on the idle machine. Sample counts, for honesty: 100 attempts with at least
+/// 5 connections with several solutions asserted found 4 and failed the count; the attempts were
+/// raised to 400 (24 such connections, 160 suffixes), the count kept at 5. Worst |Σw − 1|: 4.6e-6
+/// (cos θ_y > 0.1), 2.8e-6 (grazing), asserted below [`STATUE_ROUNDING`]. SNEE rebuilds
+/// `x_j → x_k` from two f32 points, so its look-up of the connection's density allows their
+/// rounding (`curved_finite::direction_tolerance`); without that allowance one suffix's SNEE weight
+/// leaves the density out and the sum is off by 1.07e-3.
 #[test]
 #[ignore]
 fn technique_weights_sum_to_one_on_the_statue_with_several_solutions() {
