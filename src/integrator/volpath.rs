@@ -94,12 +94,7 @@ pub fn skip_sample_emitter(scene: &Scene, p: Vec3, sampler: &mut Sampler) {
 ///   pdf is positive and finite, as `1 − cos α ≥ r² / 2|c − p|²`).
 #[inline]
 fn surely_usable(scene: &Scene, p: Vec3, u: Vec2) -> bool {
-    let n = scene.emitters.len();
-    if n == 0 {
-        return false;
-    }
-    // The emitter selection of `Scene::sample_emitter_direction`.
-    let index = ((u.x * n as f32) as u32 as usize).min(n - 1);
+    let Some((index, _)) = scene.select_emitter(u) else { return false };
     let SceneEmitter::Area { shape, radiance: Texture::Const(le) } = &scene.emitters[index] else {
         return false;
     };

@@ -78,6 +78,19 @@ impl Scene {
         1.0 / self.emitters.len() as f32
     }
 
+    /// The uniform emitter selection of [`Self::sample_emitter_direction`]: the emitter's index
+    /// and the sample with its first coordinate reused for that emitter. `None` without emitters.
+    #[inline]
+    pub fn select_emitter(&self, sample: Vec2) -> Option<(usize, Vec2)> {
+        let n = self.emitters.len();
+        if n == 0 {
+            return None;
+        }
+        let x = sample.x * n as f32;
+        let index = (x as u32 as usize).min(n - 1);
+        Some((index, Vec2::new(x - index as f32, sample.y)))
+    }
+
     /// Pick an emitter uniformly and sample a direction towards it from `ref_p`.
     /// Returns (ds, weight) where weight = L·(geometry)/pdf including the selection probability;
     /// zero weight when the sample failed or (with `test_visibility`) is occluded.
@@ -88,13 +101,10 @@ impl Scene {
         sample: Vec2,
         test_visibility: bool,
     ) -> (DirectionSample, Spectrum) {
-        let n = self.emitters.len();
-        if n == 0 {
+        let Some((index, sample)) = self.select_emitter(sample) else {
             return (DirectionSample::default(), Spectrum::ZERO);
-        }
-        let x = sample.x * n as f32;
-        let index = (x as u32 as usize).min(n - 1);
-        let sample = Vec2::new(x - index as f32, sample.y);
+        };
+        let n = self.emitters.len();
         let (mut ds, mut weight) = self.sample_one_emitter(index, ref_p, sample);
         ds.emitter = index as u32;
         ds.pdf /= n as f32;
