@@ -52,7 +52,7 @@ pub fn li(
     // Glints from the camera (`connection = complete`, docs/manifold.md §10); zero, drawing nothing,
     // elsewhere, and without a directional light (which only they take): not even its camera map
     // is built then.
-    if !has_directional(scene) {
+    if !snee.has_directional {
         return (l, valid);
     }
     (l + manifold::glint::sample(scene, snee, sampler, &ray, stats), valid)
@@ -125,6 +125,7 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         }
         snee.meter_glint = meter_glint(scene);
     }
+    snee.has_directional = has_directional(scene);
     snee.forward_only = forward_only(scene, &snee, connection);
     snee
 }
@@ -169,7 +170,7 @@ pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool 
     let no_connection = match connection {
         Connection::Paper => true,
         Connection::Complete => {
-            let directional = has_directional(scene);
+            let directional = snee.has_directional;
             snee.flat.iter().all(Option::is_none)
                 && snee.rough.iter().all(Option::is_none)
                 // The camera's glints (`manifold::glint`) take directional lights on any medium's

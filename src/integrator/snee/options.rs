@@ -80,6 +80,9 @@ pub struct Snee {
     /// or glint that serves its emitters, all transport kept): `li` is then volpath's loop, whose
     /// estimate `volpath_snee`'s would equal (`volpath_snee::forward_only`, docs/snee.md §5).
     pub forward_only: bool,
+    /// Has the scene a `directional` emitter (the only emitters the camera's glints take,
+    /// `manifold::glint`)? Decided at build, so that `li` does not scan the emitters per sample.
+    pub has_directional: bool,
     /// With `connection = complete`: the irradiance meter's direction mixture towards the glints
     /// of directional lights on the rough boundary it faces (`manifold::meter_glint`).
     pub meter_glint: Option<crate::integrator::manifold::meter_glint::MeterGlint>,

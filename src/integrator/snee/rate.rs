@@ -20,6 +20,7 @@ pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
         rough: Vec::new(),
         curved: Vec::new(),
         forward_only: false,
+        has_directional: false,
         meter_glint: None,
     }
 }
