@@ -220,6 +220,22 @@ pub fn li(
     medium: Option<u32>,
     stats: &mut LocalStats,
 ) -> (Spectrum, bool) {
+    // A camera ray outside media that finds no surface, in a scene without an environment, ends
+    // the path in the loop's first iteration with nothing added and `valid_ray` false, after the
+    // hero channel's and the first roulette's samples (the roulette of `beta = 1` at depth 0
+    // passes). Those two samples are drawn here without entering the loop; a surface the ray
+    // finds is handed to the loop, which then does not trace it again. Same samples, same result.
+    if medium.is_none() && scene.environment.is_none() && scene.integrator.max_depth != 0 {
+        stats.rays += 1;
+        let si = scene.ray_intersect(&ray);
+        if si.is_none() {
+            let _ = sampler.next_1d();
+            let _ = sampler.next_1d();
+            return (Spectrum::ZERO, false);
+        }
+        let weight = Beta { beta: Spectrum::ONE, last_scatter_pdf: 1.0 };
+        return trace_from::<_, _, true>(scene, sampler, ray, medium, stats, weight, None, &mut NoClasses, si);
+    }
     li_with(scene, sampler, ray, medium, stats, None)
 }
 
@@ -444,7 +460,25 @@ impl PathWeight for Beta {
 /// carries the estimator's weights, `snee` the SNEE stage (`volpath_snee` only); every
 /// contribution also goes to `tally` (transport classes; [`NoClasses`] does nothing).
 #[allow(clippy::too_many_arguments)]
+#[inline]
 pub fn trace<W: PathWeight, T: Tally>(
+    scene: &Scene,
+    sampler: &mut Sampler,
+    ray: Ray,
+    medium: Option<u32>,
+    stats: &mut LocalStats,
+    weight: W,
+    snee: Option<SneeStage>,
+    tally: &mut T,
+) -> (Spectrum, bool) {
+    trace_from::<W, T, false>(scene, sampler, ray, medium, stats, weight, snee, tally, None)
+}
+
+/// [`trace`]; with `TRACED`, the caller has traced the first ray already (one starting outside
+/// media, which the loop would trace first) and `first_hit` is its `ray_intersect`. A separate
+/// copy of the loop, so that [`trace`]'s own is the same as without this option.
+#[allow(clippy::too_many_arguments)]
+fn trace_from<W: PathWeight, T: Tally, const TRACED: bool>(
     scene: &Scene,
     sampler: &mut Sampler,
     ray: Ray,
@@ -453,7 +487,9 @@ pub fn trace<W: PathWeight, T: Tally>(
     mut weight: W,
     mut snee: Option<SneeStage>,
     tally: &mut T,
+    first_hit: Option<SurfaceInteraction>,
 ) -> (Spectrum, bool) {
+    debug_assert!(!TRACED || medium.is_none());
     let desc = &scene.integrator;
     let ctx = BsdfContext::default();
 
@@ -469,8 +505,8 @@ pub fn trace<W: PathWeight, T: Tally>(
     let PathSetup { max_depth, channel, .. } = setup;
     let mut last_scatter_p = ray.o;
     // The surface hit along the current ray, when already traced.
-    let mut si: Option<SurfaceInteraction> = None;
-    let mut needs_intersection = true;
+    let mut needs_intersection = !TRACED;
+    let mut si: Option<SurfaceInteraction> = if TRACED { first_hit } else { None };
     // Contributions outside SNEE's suffixes are dropped with transport = snee.
     let keep_all = snee.as_ref().is_none_or(|s| s.keeps_all());
     // Manifold NEE through flat boundaries (volpath_snee with connection = complete).

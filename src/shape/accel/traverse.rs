@@ -147,16 +147,19 @@ macro_rules! node_test_portable_body {
     };
 }
 
-/// Stack entry: a child and a lower bound of its entry distance.
+/// Stack entry: a child and a lower bound of its entry distance (`repr(C)`: the AVX2 ordering
+/// writes entries as interleaved (child, t) pairs).
 #[derive(Clone, Copy)]
+#[repr(C)]
 pub struct Entry {
     pub child: u32,
     pub t: f32,
 }
 
-/// Stack size that suffices for a tree of depth `depth` (at most 7 entries pushed per level).
+/// Stack size that suffices for a tree of depth `depth`: at most 7 entries pushed per level, and
+/// room for the AVX2 ordering, which writes eight entries from the top (`order_push_avx2`).
 pub fn stack_size(depth: usize) -> usize {
-    7 * depth + 1
+    7 * depth + 8
 }
 
 /// Fixed stack size used when the tree allows it (deeper trees use a heap stack).
@@ -187,11 +190,89 @@ macro_rules! at_mut {
     };
 }
 
+/// Ordering of three or more hit children (`mask`), portable: an insertion sort of their keys
+/// (entry distance with the slot in the low three bits) into descending order; pushes all but the
+/// last (the nearest) onto the stack, farthest first, advances `sp` and yields the nearest child.
+macro_rules! order_push_portable {
+    ($node:expr, $mask:expr, $t_near:expr, $stack:expr, $sp:ident, $key:ident) => {{
+        let (node, mut mask, stack): (&Node8, u32, &mut Stack) = ($node, $mask, $stack);
+        let mut keys = [0u32; 8];
+        let mut n = 0;
+        while mask != 0 {
+            let slot = mask.trailing_zeros();
+            mask &= mask - 1;
+            let key = $key(slot);
+            let mut i = n;
+            while i > 0 && keys[i - 1] < key {
+                keys[i] = keys[i - 1];
+                i -= 1;
+            }
+            keys[i] = key;
+            n += 1;
+        }
+        for &key in &keys[..n - 1] {
+            stack[$sp] = MaybeUninit::new(Entry { child: node.child[(key & 7) as usize], t: f32::from_bits(key & !7) });
+            $sp += 1;
+        }
+        node.child[(keys[n - 1] & 7) as usize]
+    }};
+}
+
+/// [`order_push_portable`] in AVX2 registers: the eight keys (0 for a missed child, which sorts
+/// last; a hit child's key is distinct from every other hit child's by its slot bits) sorted into
+/// descending order by a bitonic network (Batcher 1968; six compare-exchange layers of unsigned
+/// max/min), the children gathered by slot with one permute, and all eight (child, t) entries
+/// written from the stack top (`stack_size` leaves room); `sp` advances past the `n − 1` farthest.
+/// The same order as the insertion sort (the keys are distinct), so the same traversal.
+#[cfg(target_arch = "x86_64")]
+macro_rules! order_push_avx2 {
+    ($node:expr, $mask:expr, $t_near:expr, $stack:expr, $sp:ident, $key:ident) => {{
+        use std::arch::x86_64::*;
+        let (node, mask, t_near, stack): (&Node8, u32, &[f32; 8], &mut Stack) = ($node, $mask, $t_near, $stack);
+        let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        let hit = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(mask as i32), bits), bits);
+        let slot = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        let t = _mm256_castps_si256(_mm256_loadu_ps(t_near.as_ptr()));
+        let not7 = _mm256_set1_epi32(!7);
+        let mut k = _mm256_and_si256(_mm256_or_si256(_mm256_and_si256(t, not7), slot), hit);
+        // Compare-exchange with the partner lane `i ^ j`; blend bit i set: lane i keeps the max.
+        macro_rules! layer {
+            ($partner:expr, $keep_max:literal) => {{
+                let p = $partner;
+                k = _mm256_blend_epi32::<$keep_max>(_mm256_min_epu32(k, p), _mm256_max_epu32(k, p));
+            }};
+        }
+        layer!(_mm256_shuffle_epi32::<0xB1>(k), 0x99); // j = 1 in blocks of 2
+        layer!(_mm256_shuffle_epi32::<0x4E>(k), 0xC3); // j = 2 in blocks of 4
+        layer!(_mm256_shuffle_epi32::<0xB1>(k), 0xA5); // j = 1 in blocks of 4
+        layer!(_mm256_permute4x64_epi64::<0x4E>(k), 0x0F); // j = 4, whole register descending
+        layer!(_mm256_shuffle_epi32::<0x4E>(k), 0x33); // j = 2
+        layer!(_mm256_shuffle_epi32::<0xB1>(k), 0x55); // j = 1
+                                                       // SAFETY (loads): `child` is eight u32.
+        let children = _mm256_loadu_si256(node.child.as_ptr().cast());
+        let child = _mm256_permutevar8x32_epi32(children, _mm256_and_si256(k, _mm256_set1_epi32(7)));
+        let tk = _mm256_and_si256(k, not7);
+        let (lo, hi) = (_mm256_unpacklo_epi32(child, tk), _mm256_unpackhi_epi32(child, tk));
+        let n = mask.count_ones() as usize;
+        debug_assert!($sp + 8 <= stack.len());
+        // SAFETY: `stack_size` leaves room for eight entries from any `sp` the traversal reaches
+        // (at most 7 per level above), and `Entry` is `repr(C)` (child, t).
+        unsafe {
+            let top = stack.as_mut_ptr().add($sp).cast::<__m256i>();
+            _mm256_storeu_si256(top, _mm256_permute2x128_si256::<0x20>(lo, hi));
+            _mm256_storeu_si256(top.add(1), _mm256_permute2x128_si256::<0x31>(lo, hi));
+        }
+        $sp += n - 1;
+        // SAFETY: written just above.
+        unsafe { stack.get_unchecked($sp).assume_init().child }
+    }};
+}
+
 /// Closest-hit traversal with node test `$node_test`: `(lane index into lane_prims, t, b1, b2)`
 /// of the nearest triangle in (0, tmax). A macro, so that each instance is compiled with the
 /// target features of the function it expands in and the node test inlines.
 macro_rules! closest_body {
-    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident, $chk:ident) => {{
+    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident, $order:ident, $chk:ident) => {{
         let (bvh, mut tmax, stack): (&Bvh8, f32, &mut Stack) = ($bvh, $tmax, $stack);
         let tr = TraceRay::new($o, $d);
         let (nr, wt) = (&tr.node, &tr.wt);
@@ -203,7 +284,7 @@ macro_rules! closest_body {
             // Descend through inner nodes to the nearest hit child until a leaf (or nothing) is next.
             while cur & LEAF == 0 {
                 let node = at!($chk, bvh.nodes, cur as usize);
-                let mut mask = $node_test!(node, nr, tmax, &mut t_near);
+                let mask = $node_test!(node, nr, tmax, &mut t_near);
                 if mask == 0 {
                     cur = EMPTY;
                     break;
@@ -227,26 +308,8 @@ macro_rules! closest_body {
                     cur = node.child[(near & 7) as usize];
                     continue;
                 }
-                let mut keys = [0u32; 8];
-                let mut n = 0;
-                while mask != 0 {
-                    let slot = mask.trailing_zeros();
-                    mask &= mask - 1;
-                    let key = key(slot);
-                    let mut i = n;
-                    while i > 0 && keys[i - 1] < key {
-                        keys[i] = keys[i - 1];
-                        i -= 1;
-                    }
-                    keys[i] = key;
-                    n += 1;
-                }
-                for &key in &keys[..n - 1] {
-                    *at_mut!($chk, stack, sp) =
-                        MaybeUninit::new(Entry { child: node.child[(key & 7) as usize], t: f32::from_bits(key & !7) });
-                    sp += 1;
-                }
-                cur = node.child[(keys[n - 1] & 7) as usize];
+                // Three or more: all but the nearest pushed, farthest first.
+                cur = $order!(node, mask, &t_near, &mut *stack, sp, key);
             }
             if cur != EMPTY {
                 let packet = (cur & !LEAF) as usize;
@@ -316,7 +379,7 @@ macro_rules! any_body {
 
 /// Closest hit, portable node test.
 pub fn closest_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
-    closest_body!(bvh, o, d, tmax, stack, node_test_portable_body, checked)
+    closest_body!(bvh, o, d, tmax, stack, node_test_portable_body, order_push_portable, checked)
 }
 
 /// Any hit, portable node test.
@@ -333,7 +396,7 @@ pub fn any_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
 pub unsafe fn closest_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
-    closest_body!(bvh, o, d, tmax, stack, node_test_avx_body, unchecked)
+    closest_body!(bvh, o, d, tmax, stack, node_test_avx_body, order_push_avx2, unchecked)
 }
 
 /// Any hit, AVX node test.

@@ -65,11 +65,12 @@ pub struct WatertightRay {
     /// Axes (kx, ky, kz), each as 4 × axis: where the axis's row starts in a vertex's
     /// `[[f32; 4]; 3]` read as one array (so a visit adds it to the address as it is).
     k: [usize; 3],
-    /// Shear (sx, sy, sz), splatted.
-    s: [Vec4; 3],
-    /// Minus the ray origin in the permuted axes, splatted (`v + (−o)` is `v − o` bit for bit, and
+    /// Shear (sx, sy, sz, 0), one vector: a leaf visit broadcasts each lane from memory as it
+    /// would load a splatted copy, and the per-ray setup stores one vector instead of three.
+    s: Vec4,
+    /// Minus the ray origin in the permuted axes (x, y, z, 0) (`v + (−o)` is `v − o` bit for bit, and
     /// takes the vertex row as a memory operand).
-    neg_o: [Vec4; 3],
+    neg_o: Vec4,
 }
 
 /// The edge functions recomputed in `f64` (Woop et al. 2013, Sec. 3.3) in the lanes of `lanes`,
@@ -92,10 +93,10 @@ fn sheared(w: &WatertightRay, p: &TriPacket4, j: usize) -> (Vec4, Vec4, Vec4) {
     // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse_octant`),
     // so the four floats from each offset are one row of `v`.
     let row = |k: usize| unsafe { Vec4::from_array(*v.as_ptr().cast::<f32>().add(k).cast::<[f32; 4]>()) };
-    let rx = row(w.k[0]) + w.neg_o[0];
-    let ry = row(w.k[1]) + w.neg_o[1];
-    let rz = row(w.k[2]) + w.neg_o[2];
-    (rx - w.s[0] * rz, ry - w.s[1] * rz, w.s[2] * rz)
+    let rx = row(w.k[0]) + Vec4::splat(w.neg_o.x);
+    let ry = row(w.k[1]) + Vec4::splat(w.neg_o.y);
+    let rz = row(w.k[2]) + Vec4::splat(w.neg_o.z);
+    (rx - Vec4::splat(w.s.x) * rz, ry - Vec4::splat(w.s.y) * rz, Vec4::splat(w.s.z) * rz)
 }
 
 impl WatertightRay {
@@ -108,7 +109,11 @@ impl WatertightRay {
     /// The test's state from axes `k` and shear `s` as [`shear_axes`] gives them.
     pub fn from_parts(k: [usize; 3], s: [f32; 3], o: Vec3) -> Self {
         assert!(k.iter().all(|&a| a < 3), "axes {k:?}");
-        WatertightRay { k: k.map(|a| 4 * a), s: s.map(Vec4::splat), neg_o: k.map(|a| Vec4::splat(-o[a])) }
+        WatertightRay {
+            k: k.map(|a| 4 * a),
+            s: Vec4::new(s[0], s[1], s[2], 0.0),
+            neg_o: Vec4::new(-o[k[0]], -o[k[1]], -o[k[2]], 0.0),
+        }
     }
 
     /// [`WatertightRay::new`] given `neg_o` = −o and `inv` = 1 / (d + 0) per axis (the node test's unclamped inverse,
@@ -146,8 +151,8 @@ impl WatertightRay {
         };
         WatertightRay {
             k: [4 * kx, 4 * ky, 4 * kz],
-            s: [Vec4::splat(dx * sz), Vec4::splat(dy * sz), Vec4::splat(*sz)],
-            neg_o: [Vec4::splat(*ox), Vec4::splat(*oy), Vec4::splat(*oz)],
+            s: Vec4::new(dx * sz, dy * sz, *sz, 0.0),
+            neg_o: Vec4::new(*ox, *oy, *oz, 0.0),
         }
     }
 
