@@ -98,6 +98,8 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
 /// built. The connection and a forward path read it from the built options, SNEE's weight from
 /// the scene's; the weights sum to 1 only if both hold the same rate (before the built options
 /// were stored in the scene's, SNEE's side read `RATE` here). Same attempts and tolerance as above.
+/// Measured: 169 suffixes, all shared, worst |Σw − 1| 9.3e-8 (cos θ_y > 0.1) and 2.2e-7 (grazing);
+/// with the scene's options set back to the parsed ones (no rate), 0.64 and 0.65.
 #[test]
 fn technique_weights_sum_to_one_at_the_default_rate() {
     use snee::integrator::manifold::curved_finite::RATE;
