@@ -46,12 +46,12 @@ pub const RATE: f64 = 0.05;
 pub const MIN_DEPTH_FACTOR: f64 = 1e-3;
 
 /// The connection's default top rate in `scene` (when `connection_rate` is not given): over the
-/// media it serves (`curved`, per medium), the largest of `min(RATE, MEAN_RATE / m(τ))`, with `τ`
-/// the medium's optical size (`snee::rate::optical_size`) and `m(τ) = (1 − e^{−τ})/τ` the mean of
-/// [`rate_at`]'s depth factor `e^{−σ_t t0}` over depths spread evenly along a chord of optical
-/// length `τ` (`snee::rate::mean_depth_factor`); `None` where it serves no medium (the caller then
-/// keeps `RATE`). So the connection runs at about `MEAN_RATE` attempts per medium vertex whatever
-/// the medium's thickness (`snee::rate::CONNECTION_MEAN_RATE`, docs/manifold.md §8.2, "Thin
+/// media it serves (`curved`, per medium), the largest of `min(RATE, q̄ / m(τ))`, with `q̄` =
+/// `snee::rate::CONNECTION_MEAN_RATE`, `τ` the medium's optical size (`snee::rate::optical_size`)
+/// and `m(τ) = (1 − e^{−τ})/τ` the mean of [`rate_at`]'s depth factor `e^{−σ_t t0}` over depths
+/// spread evenly along a chord of optical length `τ` (`snee::rate::mean_depth_factor`); `None`
+/// where it serves no medium (the caller then keeps `RATE`). So the connection runs at about `q̄`
+/// attempts per medium vertex whatever the medium's thickness (docs/manifold.md §8.2, "Thin
 /// media"): in a thin medium every vertex is shallow and the depth factor no longer thins the
 /// attempts (an attempt costs ~100 ray casts), so the top rate falls; in a thick one (`τ` ≥ ~15)
 /// it is `RATE`, as before. A function of the scene only, decided at load.
