@@ -122,7 +122,9 @@ pub fn build(desc: IntegratorDesc, scene: &Scene) -> Integrator {
         IntegratorKind::Volpathmis => Integrator::Volpathmis(desc),
         IntegratorKind::VolpathSnee => {
             let snee = volpath_snee::build(scene, desc.snee, desc.connection);
-            Integrator::VolpathSnee(desc, snee)
+            // The options as built (the curved connection's default top rate): every technique,
+            // SNEE's weight included (`scene.integrator.snee`), must read the same rate.
+            Integrator::VolpathSnee(IntegratorDesc { snee: snee.options, ..desc }, snee)
         }
     }
 }

@@ -10,7 +10,7 @@
 //! | `connection` | string  | `paper` (default): the paper's estimator; `complete`: also manifold NEE through flat smooth boundaries (`manifold/`, docs/manifold.md) |
 //! | `reflection_chains` | boolean | with `connection = complete`: also connect through an internal reflection then a refraction (two-vertex chains, `manifold/chain.rs`, docs/manifold.md §9) under a directional light; default `false` (its cost exceeds its gain on the paper's statue) |
 //! | `snee_rate`  | float   | probability `r` of running SNEE at a scattering vertex (default: chosen per medium from its boundary and the lights, see [`snee::auto_rate`], revised under `connection = complete` by `snee::rate::complete_rates`); MIS counts SNEE's density as `r · pdf_snee`, so any `r` is unbiased |
-//! | `connection_rate` | float | with `connection = complete`: the top rate `q_top` in (0, 1] of the curved area-light connection (`manifold/curved_finite.rs`): at a medium vertex `x_j` whose emitter sample picked an area light at `y` it runs with probability `q = q_top · max(e^{−σ_t t0}, 1e-3)`, `t0` the distance from `x_j` to the boundary towards `y`; default 0.05 (`curved_finite::RATE`, docs/manifold.md §8.2); part of its density, so any `q_top` is unbiased |
+//! | `connection_rate` | float | with `connection = complete`: the top rate `q_top` in (0, 1] of the curved area-light connection (`manifold/curved_finite.rs`): at a medium vertex `x_j` whose emitter sample picked an area light at `y` it runs with probability `q = q_top · max(e^{−σ_t t0}, 1e-3)`, `t0` the distance from `x_j` to the boundary towards `y`; default `min(0.05, (1/256) / m(τ))` (`curved_finite::RATE`, `curved_finite::default_top_rate`: `m(τ) = (1 − e^{−τ})/τ` of the medium's optical size `τ`, so thin media run it less often; docs/manifold.md §8.2); part of its density, so any `q_top` is unbiased |
 //!
 //! ```xml
 //! <integrator type="volpath_snee">
@@ -120,8 +120,10 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         snee.rough = manifold::rough::rough_boundaries(scene);
         snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
         snee::rate::complete_rates(scene, &mut snee);
-        if snee.options.connection_rate.is_none() && manifold::curved_finite::off_when_thin(scene, &snee.curved) {
-            snee.options.connection_rate = Some(0.0);
+        // Only a top rate below `RATE` is stored: elsewhere `RATE` itself stands, bit for bit.
+        if snee.options.connection_rate.is_none() {
+            let q_top = manifold::curved_finite::default_top_rate(scene, &snee.curved);
+            snee.options.connection_rate = q_top.filter(|&q| q < manifold::curved_finite::RATE).map(|q| q as f32);
         }
         snee.meter_glint = meter_glint(scene);
     }
@@ -162,8 +164,8 @@ fn meter_glint(scene: &Scene) -> Option<MeterGlint> {
 /// not apply), and with `connection = complete` no connection serves the scene: no flat or rough
 /// boundary, no directional light (the camera's glints), and curved boundaries lit only by
 /// emitters that no curved technique takes
-/// ([`curved_serves`]: environments, and area lights where the curved area-light connection is
-/// off, `curved_finite::off_when_thin`; docs/manifold.md §8.2, §10).
+/// ([`curved_serves`]: environments; area lights only where `connection_rate` would be 0, which
+/// neither the parameter nor `curved_finite::default_top_rate` gives; docs/manifold.md §8.2, §10).
 pub fn forward_only(scene: &Scene, snee: &Snee, connection: Connection) -> bool {
     let options = &snee.options;
     let no_snee = options.technique == SneeTechnique::Forward || snee.rates.iter().all(|r| r.is_none_or(|r| r == 0.0));

@@ -116,6 +116,18 @@ const ENVMAP: &str = r#"<emitter type="envmap"><string name="filename" value="te
 const SPHERE_LIGHT: &str = r#"<shape type="sphere"><point name="center" x="3" y="4" z="2"/><float name="radius" value="0.3"/>
     <emitter type="area"><rgb name="radiance" value="40, 40, 40"/></emitter></shape>"#;
 
+/// The curved connection's top rate as built, checked to be the one the scene's options (which
+/// SNEE's weight reads) hold too.
+fn connection_rate(scene: &snee::scene::world::Scene) -> Option<f32> {
+    match &scene.integrator {
+        snee::integrator::desc::Integrator::VolpathSnee(d, s) => {
+            assert_eq!(d.snee.connection_rate, s.options.connection_rate);
+            s.options.connection_rate
+        }
+        _ => panic!("not volpath_snee"),
+    }
+}
+
 fn forward_only(scene: &snee::scene::world::Scene) -> bool {
     match &scene.integrator {
         snee::integrator::desc::Integrator::VolpathSnee(_, s) => s.forward_only,
@@ -140,15 +152,29 @@ fn forward_only_where_nothing_applies() {
     assert!(forward_only(&fwd));
     let (a, b) = (render_batches(&scene(&xml("volpath", ""), &[]), 2, 4, 8, 9100), render_batches(&fwd, 2, 4, 8, 9100));
     assert_eq!((a.stats, a.rays), (b.stats, b.rays));
-    // A sphere light through this thin medium: the curved area-light connection is off by default
-    // (`curved_finite::off_when_thin`), so nothing applies; with a rate given, or a thick medium
-    // (σt 3, optical size 6), it runs, and so does volpath_snee's loop.
-    assert!(forward_only(&scene(&smooth_sphere("volpath_snee", complete, SPHERE_LIGHT), &[])));
+    // A sphere light through this thin medium (optical size 2): the curved area-light connection
+    // runs at the default top rate of `curved_finite::default_top_rate`, (1/256) / m(2) with
+    // m(τ) = (1 − e^{−τ})/τ, so volpath_snee's loop runs; likewise with a rate given, or a thicker
+    // medium (σt 3, optical size 6: (1/256) / m(6)). The options every technique reads (SNEE's weight
+    // reads the scene's) hold the rate as built.
+    let thin = scene(&smooth_sphere("volpath_snee", complete, SPHERE_LIGHT), &[]);
+    assert!(!forward_only(&thin));
+    let m = |tau: f64| (1.0 - (-tau).exp()) / tau;
+    let close = |q: Option<f32>, want: f64| q.is_some_and(|q| (q as f64 / want - 1.0).abs() < 1e-6);
+    assert!(close(connection_rate(&thin), (1.0 / 256.0) / m(2.0)), "{:?}", connection_rate(&thin));
     let rate = format!(r#"{complete}<float name="connection_rate" value="0.05"/>"#);
-    assert!(!forward_only(&scene(&smooth_sphere("volpath_snee", &rate, SPHERE_LIGHT), &[])));
+    let given = scene(&smooth_sphere("volpath_snee", &rate, SPHERE_LIGHT), &[]);
+    assert!(!forward_only(&given));
+    assert_eq!(connection_rate(&given), Some(0.05));
     let thick = smooth_sphere("volpath_snee", complete, SPHERE_LIGHT)
         .replace(r#"<float name="sigma_t" value="1"/>"#, r#"<float name="sigma_t" value="3"/>"#);
-    assert!(!forward_only(&scene(&thick, &[])));
+    let thick = scene(&thick, &[]);
+    assert!(!forward_only(&thick));
+    assert!(close(connection_rate(&thick), (1.0 / 256.0) / m(6.0)), "{:?}", connection_rate(&thick));
+    // Optical size 20: the rule reaches `RATE` and leaves the option unset (`RATE` stands).
+    let thicker = smooth_sphere("volpath_snee", complete, SPHERE_LIGHT)
+        .replace(r#"<float name="sigma_t" value="1"/>"#, r#"<float name="sigma_t" value="10"/>"#);
+    assert_eq!(connection_rate(&scene(&thicker, &[])), None);
     // A directional light: the camera's glints run on the glass even where the medium does not
     // sample emitters (no SNEE, no connection).
     let sun = r#"<emitter type="directional"><vector name="direction" value="0, -1, -1"/></emitter>"#;

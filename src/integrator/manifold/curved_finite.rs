@@ -45,20 +45,27 @@ pub const RATE: f64 = 0.05;
 /// The smallest factor [`rate_at`] applies to the top rate (deep vertices keep a positive rate).
 pub const MIN_DEPTH_FACTOR: f64 = 1e-3;
 
-/// Does the connection stay off by default in `scene` (top rate 0, when `connection_rate` is not
-/// given)? When every medium it serves (`curved`, per medium) is optically thin
-/// (`snee::rate::optically_thin`, where SNEE stops running under `complete` too). There it has not paid for its cost: `sphere_smooth_st02` (optical size
-/// 0.86) read 0.77–0.90× `volpath`'s equal-time efficiency in four measurements at rates 0.05–0.1
-/// (docs/manifold.md §8.2); with the connection off and SNEE's rate 0, `volpath_snee` runs
-/// volpath's loop there (`volpath_snee::forward_only`).
-pub fn off_when_thin(scene: &Scene, curved: &[bool]) -> bool {
-    use crate::integrator::snee::rate::optically_thin;
-    let mut served = (0u32..).zip(curved).filter(|(_, &c)| c).map(|(m, _)| m).peekable();
-    served.peek().is_some() && served.all(|m| optically_thin(scene, m))
+/// The connection's default top rate in `scene` (when `connection_rate` is not given): over the
+/// media it serves (`curved`, per medium), the largest of `min(RATE, q̄ / m(τ))`, with `q̄` =
+/// `snee::rate::CONNECTION_MEAN_RATE`, `τ` the medium's optical size (`snee::rate::optical_size`)
+/// and `m(τ) = (1 − e^{−τ})/τ` the mean of [`rate_at`]'s depth factor `e^{−σ_t t0}` over depths
+/// spread evenly along a chord of optical length `τ` (`snee::rate::mean_depth_factor`); `None`
+/// where it serves no medium (the caller then keeps `RATE`). So the connection runs at about `q̄`
+/// attempts per medium vertex whatever the medium's thickness (docs/manifold.md §8.2, "Thin
+/// media"): in a thin medium every vertex is shallow and the depth factor no longer thins the
+/// attempts (an attempt costs ~100 ray casts), so the top rate falls; in a thick one (`τ` ≥ ~15)
+/// it is `RATE`, as before. A function of the scene only, decided at load.
+pub fn default_top_rate(scene: &Scene, curved: &[bool]) -> Option<f64> {
+    use crate::integrator::snee::rate::{mean_depth_factor, optical_size, CONNECTION_MEAN_RATE};
+    (0u32..)
+        .zip(curved)
+        .filter(|(_, &c)| c)
+        .map(|(m, _)| (CONNECTION_MEAN_RATE / mean_depth_factor(optical_size(scene, m) as f64)).min(RATE))
+        .reduce(f64::max)
 }
 
 /// The connection's top rate under `opts`: `connection_rate`, else [`RATE`] (`volpath_snee::build`
-/// sets it to 0 where [`off_when_thin`]).
+/// sets it from [`default_top_rate`] when not given).
 #[inline]
 pub fn rate(opts: SneeOptions) -> f64 {
     opts.connection_rate.map_or(RATE, |q| q as f64)

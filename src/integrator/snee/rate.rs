@@ -102,6 +102,24 @@ pub fn optical_size(scene: &Scene, medium: u32) -> f32 {
     scene.media[medium as usize].sigma_t.min_element() * side
 }
 
+/// The curved area-light connection's mean rate (docs/manifold.md §8.2, "Thin media"): its expected
+/// attempts per medium vertex for vertices spread evenly through the medium, which
+/// `manifold::curved_finite::default_top_rate` holds fixed across optical sizes. An attempt costs
+/// ~100 ray casts (12 Newton solves and their verification, §8.2), so 1/256 keeps its expected cost
+/// under half a ray cast per vertex, against volpath's ~2 per sample. Chosen from that cost, not from
+/// renders; in a thick medium (`τ` ≥ ~15) the top rate it gives reaches `curved_finite::RATE` and
+/// the former rate stands.
+pub const CONNECTION_MEAN_RATE: f64 = 1.0 / 256.0;
+
+/// `m(τ) = (1 − e^{−τ})/τ`: the mean of `e^{−σ_t t}` for `t` uniform along a chord of optical length
+/// `τ` (1 at `τ` = 0; `1/τ` for large `τ`); `τ ≤ 0` gives 1.
+pub fn mean_depth_factor(tau: f64) -> f64 {
+    if tau < 1e-6 {
+        return 1.0;
+    }
+    -(-tau).exp_m1() / tau
+}
+
 /// With `connection = complete` and no `snee_rate` given: the default rates of [`auto_rate`]
 /// revised once the manifold tables in `snee` are built (docs/snee.md §5), from the scene's light
 /// types, the medium's boundary kind and its optical size only. SNEE does not run (`r = 0`) in a
@@ -161,5 +179,24 @@ pub fn mixture(snee: &Snee, boundary: Boundary) -> (f32, f32) {
     match boundary {
         Boundary::Smooth { .. } if !snee.has_non_delta_emitter => (1.0, 0.0),
         _ => (0.5, 0.5),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::mean_depth_factor;
+
+    /// `m(τ)` is the mean of `e^{−t}` over `t` uniform in `[0, τ]`: checked by a midpoint sum, and
+    /// its limits (1 at 0, `1/τ` for large `τ`).
+    #[test]
+    fn mean_depth_factor_is_the_mean_transmittance() {
+        for tau in [1e-3, 0.86, 2.0, 14.6, 100.0] {
+            let n = 100_000;
+            let sum: f64 = (0..n).map(|i| (-(i as f64 + 0.5) / n as f64 * tau).exp()).sum();
+            let m = mean_depth_factor(tau);
+            assert!((m - sum / n as f64).abs() < 1e-8 * m.max(1.0), "τ {tau}: {m} vs {}", sum / n as f64);
+        }
+        assert_eq!(mean_depth_factor(0.0), 1.0);
+        assert!((mean_depth_factor(1e4) * 1e4 - 1.0).abs() < 1e-9);
     }
 }
