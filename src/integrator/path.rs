@@ -119,7 +119,8 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
 
         // ---- Russian roulette ----
         let beta_max = beta.max_element();
-        if !(beta_max > 0.0) || !beta_max.is_finite() {
+        // Not positive, NaN or infinite (one comparison each way: cheaper than `is_finite`).
+        if !(beta_max > 0.0 && beta_max < f32::INFINITY) {
             break;
         }
         if depth >= rr_depth {
