@@ -86,7 +86,7 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
         let em_sample = sampler.next_2d();
         if bsdf_flags & flags::SMOOTH != 0 && !scene.emitters.is_empty() {
             stats.rays += 1;
-            let (ds, em_weight) = scene.sample_emitter_direction(si.p, Some(si.n), em_sample, false);
+            let (ds, em_weight) = scene.sample_emitter_direction_inline(si.p, Some(si.n), em_sample, false);
             if ds.pdf > 0.0 && em_weight != Spectrum::ZERO {
                 let wo = si.to_local(ds.d);
                 let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &si, wo);
