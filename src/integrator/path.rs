@@ -92,7 +92,7 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
                 let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &si, wo);
                 // A zero BSDF value (e.g. the light below a diffuse surface) adds nothing whether
                 // or not the light is visible: the shadow ray is traced for non-zero values only.
-                if bsdf_val != Spectrum::ZERO && scene.emitter_visible(si.p, Some(si.n), &ds) {
+                if bsdf_val != Spectrum::ZERO && scene.emitter_visible_inline(si.p, Some(si.n), &ds) {
                     let mis = if ds.delta { 1.0 } else { mis_weight(ds.pdf, bsdf_pdf) };
                     result += beta * em_weight * bsdf_val * mis;
                 }

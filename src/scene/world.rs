@@ -138,6 +138,12 @@ impl Scene {
     /// origin is offset off the surface to the side of `ds.d`.
     #[inline]
     pub fn emitter_visible(&self, ref_p: Vec3, ref_n: Option<Vec3>, ds: &DirectionSample) -> bool {
+        self.emitter_visible_inline(ref_p, ref_n, ds)
+    }
+
+    /// [`Self::emitter_visible`] inlined into its caller (`path`'s shadow rays).
+    #[inline(always)]
+    pub fn emitter_visible_inline(&self, ref_p: Vec3, ref_n: Option<Vec3>, ds: &DirectionSample) -> bool {
         let o = match ref_n {
             Some(nrm) => crate::interaction::offset_origin(ref_p, nrm, ds.d),
             None => ref_p,
