@@ -49,7 +49,9 @@ pub struct EnvironmentEmitter {
     pub width: usize,
     pub height: usize,
     /// `(width + 1) × height` texels, row 0 at the +Y pole; the last column repeats the first.
-    data: Arc<[Spectrum]>,
+    /// Stored as 16-byte `Vec3A` so the bilinear lookup runs in SIMD lanes (the same per-channel
+    /// products and sums as on `Spectrum`).
+    data: Arc<[glam::Vec3A]>,
     pub scale: f32,
     pub to_world: Mat4,
     pub to_local: Mat4,
@@ -163,7 +165,7 @@ impl EnvironmentEmitter {
             filename,
             width,
             height,
-            data: data.into(),
+            data: data.iter().map(|&c| glam::Vec3A::from(c)).collect(),
             scale,
             to_world,
             to_local,
@@ -207,7 +209,7 @@ impl EnvironmentEmitter {
         let v11 = self.data[i + stride + 1];
         let v0 = w0x * v00 + w1x * v10;
         let v1 = w0x * v01 + w1x * v11;
-        (w0y * v0 + w1y * v1) * self.scale
+        Spectrum::from((w0y * v0 + w1y * v1) * self.scale)
     }
 
     /// Radiance arriving from world direction `d` (pointing away from the scene).

@@ -86,13 +86,13 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
         let em_sample = sampler.next_2d();
         if bsdf_flags & flags::SMOOTH != 0 && !scene.emitters.is_empty() {
             stats.rays += 1;
-            let (ds, em_weight) = scene.sample_emitter_direction(si.p, Some(si.n), em_sample, false);
+            let (ds, em_weight) = scene.sample_emitter_direction_inline(si.p, Some(si.n), em_sample, false);
             if ds.pdf > 0.0 && em_weight != Spectrum::ZERO {
                 let wo = si.to_local(ds.d);
                 let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &si, wo);
                 // A zero BSDF value (e.g. the light below a diffuse surface) adds nothing whether
                 // or not the light is visible: the shadow ray is traced for non-zero values only.
-                if bsdf_val != Spectrum::ZERO && scene.emitter_visible(si.p, Some(si.n), &ds) {
+                if bsdf_val != Spectrum::ZERO && scene.emitter_visible_inline(si.p, Some(si.n), &ds) {
                     let mis = if ds.delta { 1.0 } else { mis_weight(ds.pdf, bsdf_pdf) };
                     result += beta * em_weight * bsdf_val * mis;
                 }
@@ -119,7 +119,8 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
 
         // ---- Russian roulette ----
         let beta_max = beta.max_element();
-        if !(beta_max > 0.0) || !beta_max.is_finite() {
+        // Not positive, NaN or infinite (one comparison each way: cheaper than `is_finite`).
+        if !(beta_max > 0.0 && beta_max < f32::INFINITY) {
             break;
         }
         if depth >= rr_depth {
