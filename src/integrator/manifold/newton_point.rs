@@ -28,7 +28,7 @@
 //! technique's density of a given suffix can be evaluated by re-solving from that seed.
 
 use super::newton::{
-    central_jacobian, damped_step, moved, tangents, Failure, Locate, Patch, Refracted, MAX_ITERATIONS,
+    central_jacobian, damped_step, moved, tangents, Failure, Locate, Patch, Refracted, Surface, MAX_ITERATIONS,
 };
 use crate::math::DVec3;
 
@@ -112,6 +112,11 @@ pub fn seed_line(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> (Option<f64>
 /// the enclosing boundary from inside or `y` is behind `n_s`.
 pub fn refracted_seed_along(locate: &mut impl Locate, x_j: DVec3, y: DVec3, d: DVec3) -> Option<DVec3> {
     let patch = locate.locate(x_j, d)?;
+    refracted_seed_on(&patch, x_j, y, d)
+}
+
+/// [`refracted_seed_along`] on the patch `locate` gave for `d` (no ray cast).
+fn refracted_seed_on(patch: &Patch, x_j: DVec3, y: DVec3, d: DVec3) -> Option<DVec3> {
     let (_, x_k, n_s) = patch.hit(x_j, d)?;
     super::newton::seed_from_light((y - x_k).normalize(), n_s, patch.eta)
 }
@@ -130,9 +135,72 @@ pub fn solve_point(
     y: DVec3,
     seed: DVec3,
 ) -> Result<PointSolution, (Failure, u32)> {
+    match converge(locate, x_j, y, seed, None, &[]) {
+        Ok(Converged::New(s)) => Ok(s),
+        Ok(Converged::Known { iterations }) => Err((Failure::NoConvergence, iterations)),
+        Err(e) => Err(e),
+    }
+}
+
+/// How [`converge`] ended: a solution (with its `G`), or an iterate within [`MERGE`] of a solution
+/// already `known`, where it stopped.
+enum Converged {
+    New(PointSolution),
+    Known { iterations: u32 },
+}
+
+/// Is the candidate direction `d` from `x_j` inside the triangle of `patch` (barycentrics in
+/// `[0, 1]`, the hit ahead of `x_j`)? Then a Newton step stays on that triangle without a ray cast
+/// ([`converge`]'s line search); spheres always cast.
+fn stays_on(patch: &Patch, x_j: DVec3, d: DVec3) -> bool {
+    let Surface::Triangle { p, .. } = patch.surface else { return false };
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let ng = e1.cross(e2);
+    let denom = d.dot(ng);
+    if denom == 0.0 {
+        return false;
+    }
+    let t = (p[0] - x_j).dot(ng) / denom;
+    if !(t > 0.0) {
+        return false;
+    }
+    let q = x_j + d * t - p[0];
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (q1, q2) = (q.dot(e1), q.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    let b1 = (d22 * q1 - d12 * q2) / det;
+    let b2 = (d11 * q2 - d12 * q1) / det;
+    b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0
+}
+
+/// Newton iterates closer than this (radians) to a solution already found stop there
+/// ([`solve_distinct`]): from so close the iteration converges to that solution (quadratic
+/// convergence from a step of at most `MERGE` on a well-conditioned map), so finishing it and its
+/// `G` would only find the same solution again. A rule on `(x_j, y)`'s own seeds and iterates, so
+/// the procedure stays a function of `(x_j, y)`; two distinct solutions closer than this keep only
+/// the first.
+pub const MERGE: f64 = 1e-3;
+
+/// [`solve_point`]'s damped Newton from `seed`, with three savings that keep it a function of its
+/// arguments: the seed's boundary patch may be given (`seed_patch`: the caller already cast that
+/// ray); a line-search candidate that stays inside the current triangle ([`stays_on`]) takes that
+/// triangle without a ray cast (the connection verifies every solution with the renderer's own
+/// ray cast afterwards); and an iterate within [`MERGE`] of a `known` solution stops
+/// ([`Converged::Known`]). `G` only for a new solution.
+fn converge(
+    locate: &mut impl Locate,
+    x_j: DVec3,
+    y: DVec3,
+    seed: DVec3,
+    seed_patch: Option<Patch>,
+    known: &[PointSolution],
+) -> Result<Converged, (Failure, u32)> {
     let scale = (y - x_j).length();
     let mut omega = seed.normalize();
-    let mut patch = locate.locate(x_j, omega).ok_or((Failure::Lost, 0))?;
+    let mut patch = match seed_patch {
+        Some(p) => p,
+        None => locate.locate(x_j, omega).ok_or((Failure::Lost, 0))?,
+    };
     let r0 = patch.refract(x_j, omega).ok_or((Failure::Lost, 0))?;
     // The constraint's plane: perpendicular to the direction towards y from the seed's x_k.
     let l = (y - r0.x_k).normalize();
@@ -142,8 +210,14 @@ pub fn solve_point(
         let c = residual(p, y, lt);
         let norm = (p - y).length();
         if norm < TOLERANCE * scale {
+            if known.iter().any(|k| (k.omega - omega).length() < SAME_SOLUTION) {
+                return Ok(Converged::Known { iterations: it });
+            }
             let g = geometry_term(&patch, x_j, omega, y, r.o).ok_or((Failure::NoConvergence, it))?;
-            return Ok(PointSolution { omega, refracted: r, patch, g, iterations: it });
+            return Ok(Converged::New(PointSolution { omega, refracted: r, patch, g, iterations: it }));
+        }
+        if known.iter().any(|k| (k.omega - omega).length() < MERGE) {
+            return Ok(Converged::Known { iterations: it });
         }
         if it == MAX_ITERATIONS {
             break;
@@ -154,7 +228,7 @@ pub fn solve_point(
             break;
         }
         let step = damped_step(omega, j, c, det, |cand| {
-            let pc = locate.locate(x_j, cand)?;
+            let pc = if stays_on(&patch, x_j, cand) { patch } else { locate.locate(x_j, cand)? };
             let (rc, qc) = beam(&pc, x_j, cand, y, l)?;
             ((qc - y).length() < norm).then_some((pc, rc, qc))
         });
@@ -198,6 +272,8 @@ pub struct Distinct {
     /// Solves that failed, by cause.
     pub lost: u32,
     pub not_converged: u32,
+    /// Solves that stopped at (or converged to) a solution already found ([`MERGE`]).
+    pub merged: u32,
 }
 
 /// The connection's deterministic procedure (docs/manifold.md §8.2, "Several solutions per
@@ -220,21 +296,33 @@ pub fn solve_distinct(
     let ring = tangents(first);
     let mut chain = Some(first);
     for k in 0..max_seeds {
-        let seed = if k < CHAIN_SEEDS {
+        // A chain seed's ray is cast once: its patch serves both its own solve and the next seed.
+        let (seed, seed_patch) = if k < CHAIN_SEEDS {
             let Some(seed) = chain else { continue };
-            chain = if k + 1 < CHAIN_SEEDS { refracted_seed_along(locate, x_j, y, seed) } else { None };
-            seed
+            let patch = locate.locate(x_j, seed);
+            chain = match &patch {
+                Some(p) if k + 1 < CHAIN_SEEDS => refracted_seed_on(p, x_j, y, seed),
+                _ => None,
+            };
+            out.solves += 1;
+            let Some(patch) = patch else {
+                out.lost += 1;
+                continue;
+            };
+            (seed, Some(patch))
         } else {
             let phi = (k - CHAIN_SEEDS) as f64 * std::f64::consts::TAU / RING_SEEDS as f64;
-            moved(first, ring, RING * phi.cos(), RING * phi.sin())
+            out.solves += 1;
+            (moved(first, ring, RING * phi.cos(), RING * phi.sin()), None)
         };
-        out.solves += 1;
-        match solve_point(locate, x_j, y, seed) {
-            Ok(s) => {
+        match converge(locate, x_j, y, seed, seed_patch, &out.solutions) {
+            Ok(Converged::New(s)) => {
                 out.iterations += s.iterations;
-                if out.solutions.iter().all(|o| (o.omega - s.omega).length() >= SAME_SOLUTION) {
-                    out.solutions.push(s);
-                }
+                out.solutions.push(s);
+            }
+            Ok(Converged::Known { iterations }) => {
+                out.iterations += iterations;
+                out.merged += 1;
             }
             Err((f, it)) => {
                 out.iterations += it;
