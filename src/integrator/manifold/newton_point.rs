@@ -77,6 +77,30 @@ fn jacobian(patch: &Patch, x_j: DVec3, omega: DVec3, y: DVec3, l: DVec3) -> Opti
     central_jacobian(FD_STEP, |a, b| Some(residual(beam(patch, x_j, moved(omega, t, a, b), y, l)?.1, y, lt)))
 }
 
+/// `dC/d(a, b)` for a Newton step: forward differences from the residual `c` at `omega` (two
+/// evaluations of the closed form instead of [`jacobian`]'s four). Its relative error, of the order
+/// of `FD_STEP`, only slows the quadratic convergence by that factor per step; `G` keeps the
+/// central differences.
+fn step_jacobian(
+    patch: &Patch,
+    x_j: DVec3,
+    omega: DVec3,
+    y: DVec3,
+    l: DVec3,
+    lt: (DVec3, DVec3),
+    c: [f64; 2],
+) -> Option<[[f64; 2]; 2]> {
+    let t = tangents(omega);
+    let mut j = [[0.0; 2]; 2];
+    for (col, (a, b)) in [(FD_STEP, 0.0), (0.0, FD_STEP)].into_iter().enumerate() {
+        let r = residual(beam(patch, x_j, moved(omega, t, a, b), y, l)?.1, y, lt);
+        for row in 0..2 {
+            j[row][col] = (r[row] - c[row]) / FD_STEP;
+        }
+    }
+    Some(j)
+}
+
 /// The generalized geometry term `G = dω/dA⊥(y)` at a solution `omega` (refracting into `o`):
 /// the inverse determinant of the map `omega ↦ Φ_o(omega)` (`l = o`: the plane perpendicular to
 /// the outgoing ray at `y`).
@@ -222,7 +246,7 @@ fn converge(
         if it == MAX_ITERATIONS {
             break;
         }
-        let j = jacobian(&patch, x_j, omega, y, l).ok_or((Failure::Lost, it))?;
+        let j = step_jacobian(&patch, x_j, omega, y, l, lt, c).ok_or((Failure::Lost, it))?;
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
         if !(det.abs() > 1e-300) || !det.is_finite() {
             break;
@@ -254,10 +278,15 @@ pub const CHAIN_SEEDS: usize = 4;
 /// How many seeds of [`solve_distinct`] lie on a ring of angular radius [`RING`] around the first
 /// seed (after the chain).
 pub const RING_SEEDS: usize = 8;
+/// How many seeds of [`solve_distinct`] lie on a second, wider ring of angular radius [`RING2`]
+/// around the first seed (after the first ring).
+pub const RING2_SEEDS: usize = 8;
 /// All seeds of the procedure.
-pub const SEEDS: usize = CHAIN_SEEDS + RING_SEEDS;
+pub const SEEDS: usize = CHAIN_SEEDS + RING_SEEDS + RING2_SEEDS;
 /// Angular radius (radians) of the ring of seeds around the first seed.
 pub const RING: f64 = 0.1;
+/// Angular radius (radians) of the second ring.
+pub const RING2: f64 = 0.25;
 
 /// Two directions are the same solution when they differ by less than this (radians).
 pub const SAME_SOLUTION: f64 = 1e-4;
@@ -277,13 +306,15 @@ pub struct Distinct {
 }
 
 /// The connection's deterministic procedure (docs/manifold.md §8.2, "Several solutions per
-/// vertex"): Newton ([`solve_point`]) from each of `max_seeds` seeds — the chain of [`CHAIN_SEEDS`]
+/// vertex"): Newton ([`converge`]) from each of `max_seeds` seeds — the chain of [`CHAIN_SEEDS`]
 /// refracted seeds starting at `first` ([`seed_line`]'s seed, computed by the caller), each
 /// the refracted seed along the previous one, then [`RING_SEEDS`] seeds on a ring of radius
-/// [`RING`] around `first` — keeping every DISTINCT converged solution (directions apart by
-/// [`SAME_SOLUTION`] or more). A function of `(x_j, y)` only, so the set is evaluable for any
-/// suffix by running the procedure again; an estimator summing over the set is unbiased with
-/// density `q p_y / (G |cos θ_y|) · [the set holds the suffix]`. No seed at all without `first`.
+/// [`RING`] around `first`, then [`RING2_SEEDS`] on a ring of radius [`RING2`] — keeping every
+/// DISTINCT converged solution (directions apart by [`SAME_SOLUTION`] or more; a solve whose
+/// iterate comes within [`MERGE`] of one already kept stops). A function of `(x_j, y)` only, so the
+/// set is evaluable for any suffix by running the procedure again; an estimator summing over the
+/// set is unbiased with density `q p_y / (G |cos θ_y|) · [the set holds the suffix]`. No seed at
+/// all without `first`.
 pub fn solve_distinct(
     locate: &mut impl Locate,
     x_j: DVec3,
@@ -311,9 +342,14 @@ pub fn solve_distinct(
             };
             (seed, Some(patch))
         } else {
-            let phi = (k - CHAIN_SEEDS) as f64 * std::f64::consts::TAU / RING_SEEDS as f64;
+            let (i, n, radius) = if k < CHAIN_SEEDS + RING_SEEDS {
+                (k - CHAIN_SEEDS, RING_SEEDS, RING)
+            } else {
+                (k - CHAIN_SEEDS - RING_SEEDS, RING2_SEEDS, RING2)
+            };
+            let phi = i as f64 * std::f64::consts::TAU / n as f64;
             out.solves += 1;
-            (moved(first, ring, RING * phi.cos(), RING * phi.sin()), None)
+            (moved(first, ring, radius * phi.cos(), radius * phi.sin()), None)
         };
         match converge(locate, x_j, y, seed, seed_patch, &out.solutions) {
             Ok(Converged::New(s)) => {
