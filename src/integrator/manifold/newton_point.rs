@@ -167,7 +167,8 @@ pub fn solve_point(
 }
 
 /// How [`converge`] ended: a solution (with its `G`), or an iterate within [`MERGE`] of a solution
-/// already `known`, where it stopped.
+/// already `known`, where it stopped. (A return value only, never stored: its size does not matter.)
+#[allow(clippy::large_enum_variant)]
 enum Converged {
     New(PointSolution),
     Known { iterations: u32 },
