@@ -305,6 +305,8 @@ fn diagnose_statue_forward_suffixes_found() {
     };
     use snee::math::{DVec3, Ray, Vec3};
     let sigma_t: f64 = std::env::var("STATUE_SIGMA_T").ok().and_then(|s| s.parse().ok()).unwrap_or(34.0);
+    // STATUE_PROCEDURE_ONLY set: only the procedure's row (about a tenth of the time).
+    let procedure_only = std::env::var("STATUE_PROCEDURE_ONLY").is_ok();
     let xml = std::fs::read_to_string(common::root().join("scenes/paper/sphere_smooth_st34.xml")).unwrap();
     let xml = xml
         .replace(
@@ -318,8 +320,16 @@ fn diagnose_statue_forward_suffixes_found() {
     // Seed sets, each tried in full (every distinct converged solution kept): the first seed; the
     // chain of refracted seeds along the previous seed (`refracted_seed_along`); the first seed and
     // a ring of 8 at 0.1 rad; the exact forward direction (reachability).
-    const SETS: usize = 7;
-    let names = ["first", "chain 2", "chain 3", "chain 4", "first + ring 8", "exact w (reach)", "procedure"];
+    // STATUE_EXTRA_RING="R N": one more set, the procedure's seeds and a second ring of N seeds at
+    // R rad around the first (a candidate procedure).
+    const SETS: usize = 8;
+    let names = ["first", "chain 2", "chain 3", "chain 4", "first + ring 8", "exact w (reach)", "procedure", "+ ring"];
+    let extra: Option<(f64, usize)> = std::env::var("STATUE_EXTRA_RING").ok().map(|s| {
+        let v: Vec<&str> = s.split_whitespace().collect();
+        (v[0].parse().unwrap(), v[1].parse().unwrap())
+    });
+    let sets =
+        if procedure_only { 6..if extra.is_some() { 8 } else { 7 } } else { 0..if extra.is_some() { 8 } else { 7 } };
     let mut rng = snee::sampler::Sampler::new(7, 1);
     let mut u = move || rng.next_1d() as f64;
     let (mut total, mut hits, mut solutions) = (0.0f64, 0u32, 0u64);
@@ -358,7 +368,7 @@ fn diagnose_statue_forward_suffixes_found() {
             let weight = (-sigma_t * rf.t).exp();
             total += weight;
             hits += 1;
-            for v in 0..SETS {
+            for v in sets.clone() {
                 let mut locate = SceneLocate { scene: &scene, medium: 0, rays: 0 };
                 let first = point_seed(&mut locate, x, y);
                 let mut seeds: Vec<DVec3> = Vec::new();
@@ -383,6 +393,29 @@ fn diagnose_statue_forward_suffixes_found() {
                                     0.1 * a.cos(),
                                     0.1 * a.sin(),
                                 ));
+                            }
+                        }
+                    }
+                    7 => {
+                        let (radius, count) = extra.unwrap();
+                        let mut s = first;
+                        for _ in 0..4 {
+                            let Some(d) = s else { break };
+                            seeds.push(d);
+                            s = refracted_seed_along(&mut locate, x, y, d);
+                        }
+                        if let Some(f) = first {
+                            let t = snee::integrator::manifold::newton::tangents(f);
+                            for (r, n) in [(0.1, 8), (radius, count)] {
+                                for i in 0..n {
+                                    let a = i as f64 * std::f64::consts::TAU / n as f64;
+                                    seeds.push(snee::integrator::manifold::newton::moved(
+                                        f,
+                                        t,
+                                        r * a.cos(),
+                                        r * a.sin(),
+                                    ));
+                                }
                             }
                         }
                     }
@@ -428,7 +461,7 @@ fn diagnose_statue_forward_suffixes_found() {
         }
     }
     eprintln!("σt {sigma_t}: {vertices} vertices, {hits} forward suffixes reaching the light");
-    for v in 0..SETS {
+    for v in sets {
         eprintln!(
             "{:>16}: found {:.1} % of the weighted suffixes; {:.2} solves, {:.1} rays per call",
             names[v],

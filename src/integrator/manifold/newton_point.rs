@@ -28,7 +28,7 @@
 //! technique's density of a given suffix can be evaluated by re-solving from that seed.
 
 use super::newton::{
-    central_jacobian, damped_step, moved, tangents, Failure, Locate, Patch, Refracted, MAX_ITERATIONS,
+    central_jacobian, damped_step, moved, tangents, Failure, Locate, Patch, Refracted, Surface, MAX_ITERATIONS,
 };
 use crate::math::DVec3;
 
@@ -77,6 +77,30 @@ fn jacobian(patch: &Patch, x_j: DVec3, omega: DVec3, y: DVec3, l: DVec3) -> Opti
     central_jacobian(FD_STEP, |a, b| Some(residual(beam(patch, x_j, moved(omega, t, a, b), y, l)?.1, y, lt)))
 }
 
+/// `dC/d(a, b)` for a Newton step: forward differences from the residual `c` at `omega` (two
+/// evaluations of the closed form instead of [`jacobian`]'s four). Its relative error, of the order
+/// of `FD_STEP`, only slows the quadratic convergence by that factor per step; `G` keeps the
+/// central differences.
+fn step_jacobian(
+    patch: &Patch,
+    x_j: DVec3,
+    omega: DVec3,
+    y: DVec3,
+    l: DVec3,
+    lt: (DVec3, DVec3),
+    c: [f64; 2],
+) -> Option<[[f64; 2]; 2]> {
+    let t = tangents(omega);
+    let mut j = [[0.0; 2]; 2];
+    for (col, (a, b)) in [(FD_STEP, 0.0), (0.0, FD_STEP)].into_iter().enumerate() {
+        let r = residual(beam(patch, x_j, moved(omega, t, a, b), y, l)?.1, y, lt);
+        for row in 0..2 {
+            j[row][col] = (r[row] - c[row]) / FD_STEP;
+        }
+    }
+    Some(j)
+}
+
 /// The generalized geometry term `G = dω/dA⊥(y)` at a solution `omega` (refracting into `o`):
 /// the inverse determinant of the map `omega ↦ Φ_o(omega)` (`l = o`: the plane perpendicular to
 /// the outgoing ray at `y`).
@@ -112,6 +136,11 @@ pub fn seed_line(locate: &mut impl Locate, x_j: DVec3, y: DVec3) -> (Option<f64>
 /// the enclosing boundary from inside or `y` is behind `n_s`.
 pub fn refracted_seed_along(locate: &mut impl Locate, x_j: DVec3, y: DVec3, d: DVec3) -> Option<DVec3> {
     let patch = locate.locate(x_j, d)?;
+    refracted_seed_on(&patch, x_j, y, d)
+}
+
+/// [`refracted_seed_along`] on the patch `locate` gave for `d` (no ray cast).
+fn refracted_seed_on(patch: &Patch, x_j: DVec3, y: DVec3, d: DVec3) -> Option<DVec3> {
     let (_, x_k, n_s) = patch.hit(x_j, d)?;
     super::newton::seed_from_light((y - x_k).normalize(), n_s, patch.eta)
 }
@@ -130,9 +159,73 @@ pub fn solve_point(
     y: DVec3,
     seed: DVec3,
 ) -> Result<PointSolution, (Failure, u32)> {
+    match converge(locate, x_j, y, seed, None, &[]) {
+        Ok(Converged::New(s)) => Ok(s),
+        Ok(Converged::Known { iterations }) => Err((Failure::NoConvergence, iterations)),
+        Err(e) => Err(e),
+    }
+}
+
+/// How [`converge`] ended: a solution (with its `G`), or an iterate within [`MERGE`] of a solution
+/// already `known`, where it stopped. (A return value only, never stored: its size does not matter.)
+#[allow(clippy::large_enum_variant)]
+enum Converged {
+    New(PointSolution),
+    Known { iterations: u32 },
+}
+
+/// Is the candidate direction `d` from `x_j` inside the triangle of `patch` (barycentrics in
+/// `[0, 1]`, the hit ahead of `x_j`)? Then a Newton step stays on that triangle without a ray cast
+/// ([`converge`]'s line search); spheres always cast.
+fn stays_on(patch: &Patch, x_j: DVec3, d: DVec3) -> bool {
+    let Surface::Triangle { p, .. } = patch.surface else { return false };
+    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+    let ng = e1.cross(e2);
+    let denom = d.dot(ng);
+    if denom == 0.0 {
+        return false;
+    }
+    let t = (p[0] - x_j).dot(ng) / denom;
+    if !(t > 0.0) {
+        return false;
+    }
+    let q = x_j + d * t - p[0];
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (q1, q2) = (q.dot(e1), q.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    let b1 = (d22 * q1 - d12 * q2) / det;
+    let b2 = (d11 * q2 - d12 * q1) / det;
+    b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0
+}
+
+/// Newton iterates closer than this (radians) to a solution already found stop there
+/// ([`solve_distinct`]): from so close the iteration converges to that solution (quadratic
+/// convergence from a step of at most `MERGE` on a well-conditioned map), so finishing it and its
+/// `G` would only find the same solution again. A rule on `(x_j, y)`'s own seeds and iterates, so
+/// the procedure stays a function of `(x_j, y)`; two distinct solutions closer than this keep only
+/// the first.
+pub const MERGE: f64 = 1e-3;
+
+/// [`solve_point`]'s damped Newton from `seed`, with three savings that keep it a function of its
+/// arguments: the seed's boundary patch may be given (`seed_patch`: the caller already cast that
+/// ray); a line-search candidate that stays inside the current triangle ([`stays_on`]) takes that
+/// triangle without a ray cast (the connection verifies every solution with the renderer's own
+/// ray cast afterwards); and an iterate within [`MERGE`] of a `known` solution stops
+/// ([`Converged::Known`]). `G` only for a new solution.
+fn converge(
+    locate: &mut impl Locate,
+    x_j: DVec3,
+    y: DVec3,
+    seed: DVec3,
+    seed_patch: Option<Patch>,
+    known: &[PointSolution],
+) -> Result<Converged, (Failure, u32)> {
     let scale = (y - x_j).length();
     let mut omega = seed.normalize();
-    let mut patch = locate.locate(x_j, omega).ok_or((Failure::Lost, 0))?;
+    let mut patch = match seed_patch {
+        Some(p) => p,
+        None => locate.locate(x_j, omega).ok_or((Failure::Lost, 0))?,
+    };
     let r0 = patch.refract(x_j, omega).ok_or((Failure::Lost, 0))?;
     // The constraint's plane: perpendicular to the direction towards y from the seed's x_k.
     let l = (y - r0.x_k).normalize();
@@ -142,19 +235,25 @@ pub fn solve_point(
         let c = residual(p, y, lt);
         let norm = (p - y).length();
         if norm < TOLERANCE * scale {
+            if known.iter().any(|k| (k.omega - omega).length() < SAME_SOLUTION) {
+                return Ok(Converged::Known { iterations: it });
+            }
             let g = geometry_term(&patch, x_j, omega, y, r.o).ok_or((Failure::NoConvergence, it))?;
-            return Ok(PointSolution { omega, refracted: r, patch, g, iterations: it });
+            return Ok(Converged::New(PointSolution { omega, refracted: r, patch, g, iterations: it }));
+        }
+        if known.iter().any(|k| (k.omega - omega).length() < MERGE) {
+            return Ok(Converged::Known { iterations: it });
         }
         if it == MAX_ITERATIONS {
             break;
         }
-        let j = jacobian(&patch, x_j, omega, y, l).ok_or((Failure::Lost, it))?;
+        let j = step_jacobian(&patch, x_j, omega, y, l, lt, c).ok_or((Failure::Lost, it))?;
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
         if !(det.abs() > 1e-300) || !det.is_finite() {
             break;
         }
         let step = damped_step(omega, j, c, det, |cand| {
-            let pc = locate.locate(x_j, cand)?;
+            let pc = if stays_on(&patch, x_j, cand) { patch } else { locate.locate(x_j, cand)? };
             let (rc, qc) = beam(&pc, x_j, cand, y, l)?;
             ((qc - y).length() < norm).then_some((pc, rc, qc))
         });
@@ -180,10 +279,15 @@ pub const CHAIN_SEEDS: usize = 4;
 /// How many seeds of [`solve_distinct`] lie on a ring of angular radius [`RING`] around the first
 /// seed (after the chain).
 pub const RING_SEEDS: usize = 8;
+/// How many seeds of [`solve_distinct`] lie on a second, wider ring of angular radius [`RING2`]
+/// around the first seed (after the first ring).
+pub const RING2_SEEDS: usize = 8;
 /// All seeds of the procedure.
-pub const SEEDS: usize = CHAIN_SEEDS + RING_SEEDS;
+pub const SEEDS: usize = CHAIN_SEEDS + RING_SEEDS + RING2_SEEDS;
 /// Angular radius (radians) of the ring of seeds around the first seed.
 pub const RING: f64 = 0.1;
+/// Angular radius (radians) of the second ring.
+pub const RING2: f64 = 0.25;
 
 /// Two directions are the same solution when they differ by less than this (radians).
 pub const SAME_SOLUTION: f64 = 1e-4;
@@ -198,16 +302,20 @@ pub struct Distinct {
     /// Solves that failed, by cause.
     pub lost: u32,
     pub not_converged: u32,
+    /// Solves that stopped at (or converged to) a solution already found ([`MERGE`]).
+    pub merged: u32,
 }
 
 /// The connection's deterministic procedure (docs/manifold.md §8.2, "Several solutions per
-/// vertex"): Newton ([`solve_point`]) from each of `max_seeds` seeds — the chain of [`CHAIN_SEEDS`]
+/// vertex"): Newton ([`converge`]) from each of `max_seeds` seeds — the chain of [`CHAIN_SEEDS`]
 /// refracted seeds starting at `first` ([`seed_line`]'s seed, computed by the caller), each
 /// the refracted seed along the previous one, then [`RING_SEEDS`] seeds on a ring of radius
-/// [`RING`] around `first` — keeping every DISTINCT converged solution (directions apart by
-/// [`SAME_SOLUTION`] or more). A function of `(x_j, y)` only, so the set is evaluable for any
-/// suffix by running the procedure again; an estimator summing over the set is unbiased with
-/// density `q p_y / (G |cos θ_y|) · [the set holds the suffix]`. No seed at all without `first`.
+/// [`RING`] around `first`, then [`RING2_SEEDS`] on a ring of radius [`RING2`] — keeping every
+/// DISTINCT converged solution (directions apart by [`SAME_SOLUTION`] or more; a solve whose
+/// iterate comes within [`MERGE`] of one already kept stops). A function of `(x_j, y)` only, so the
+/// set is evaluable for any suffix by running the procedure again; an estimator summing over the
+/// set is unbiased with density `q p_y / (G |cos θ_y|) · [the set holds the suffix]`. No seed at
+/// all without `first`.
 pub fn solve_distinct(
     locate: &mut impl Locate,
     x_j: DVec3,
@@ -220,21 +328,38 @@ pub fn solve_distinct(
     let ring = tangents(first);
     let mut chain = Some(first);
     for k in 0..max_seeds {
-        let seed = if k < CHAIN_SEEDS {
+        // A chain seed's ray is cast once: its patch serves both its own solve and the next seed.
+        let (seed, seed_patch) = if k < CHAIN_SEEDS {
             let Some(seed) = chain else { continue };
-            chain = if k + 1 < CHAIN_SEEDS { refracted_seed_along(locate, x_j, y, seed) } else { None };
-            seed
+            let patch = locate.locate(x_j, seed);
+            chain = match &patch {
+                Some(p) if k + 1 < CHAIN_SEEDS => refracted_seed_on(p, x_j, y, seed),
+                _ => None,
+            };
+            out.solves += 1;
+            let Some(patch) = patch else {
+                out.lost += 1;
+                continue;
+            };
+            (seed, Some(patch))
         } else {
-            let phi = (k - CHAIN_SEEDS) as f64 * std::f64::consts::TAU / RING_SEEDS as f64;
-            moved(first, ring, RING * phi.cos(), RING * phi.sin())
+            let (i, n, radius) = if k < CHAIN_SEEDS + RING_SEEDS {
+                (k - CHAIN_SEEDS, RING_SEEDS, RING)
+            } else {
+                (k - CHAIN_SEEDS - RING_SEEDS, RING2_SEEDS, RING2)
+            };
+            let phi = i as f64 * std::f64::consts::TAU / n as f64;
+            out.solves += 1;
+            (moved(first, ring, radius * phi.cos(), radius * phi.sin()), None)
         };
-        out.solves += 1;
-        match solve_point(locate, x_j, y, seed) {
-            Ok(s) => {
+        match converge(locate, x_j, y, seed, seed_patch, &out.solutions) {
+            Ok(Converged::New(s)) => {
                 out.iterations += s.iterations;
-                if out.solutions.iter().all(|o| (o.omega - s.omega).length() >= SAME_SOLUTION) {
-                    out.solutions.push(s);
-                }
+                out.solutions.push(s);
+            }
+            Ok(Converged::Known { iterations }) => {
+                out.iterations += iterations;
+                out.merged += 1;
             }
             Err((f, it)) => {
                 out.iterations += it;
