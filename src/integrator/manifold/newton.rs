@@ -71,29 +71,36 @@ pub struct Refracted {
     pub t: f64,
 }
 
+/// Where the ray `(x, d)` meets the plane of the triangle `p`: the distance `t > 0` and the
+/// barycentrics `(b1, b2)` of the hit in that plane (extended beyond the triangle's edges); `None`
+/// when the ray is parallel to the plane or the plane lies behind `x`.
+pub fn triangle_plane_hit(p: &[DVec3; 3], x: DVec3, d: DVec3) -> Option<(f64, f64, f64)> {
+    let e1 = p[1] - p[0];
+    let e2 = p[2] - p[0];
+    let ng = e1.cross(e2);
+    let denom = d.dot(ng);
+    if denom == 0.0 {
+        return None;
+    }
+    let t = (p[0] - x).dot(ng) / denom;
+    if !(t > 0.0) {
+        return None;
+    }
+    let q = x + d * t - p[0];
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (q1, q2) = (q.dot(e1), q.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    let b1 = (d22 * q1 - d12 * q2) / det;
+    let b2 = (d11 * q2 - d12 * q1) / det;
+    Some((t, b1, b2))
+}
+
 impl Patch {
     /// Hit of the ray `(x, d)` with the extended surface and the shading normal there.
     pub fn hit(&self, x: DVec3, d: DVec3) -> Option<(f64, DVec3, DVec3)> {
         match self.surface {
             Surface::Triangle { p, n } => {
-                let e1 = p[1] - p[0];
-                let e2 = p[2] - p[0];
-                let ng = e1.cross(e2);
-                let denom = d.dot(ng);
-                if denom == 0.0 {
-                    return None;
-                }
-                let t = (p[0] - x).dot(ng) / denom;
-                if !(t > 0.0) {
-                    return None;
-                }
-                let q = x + d * t - p[0];
-                // Barycentrics of q in the triangle's plane (extended beyond its edges).
-                let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-                let (q1, q2) = (q.dot(e1), q.dot(e2));
-                let det = d11 * d22 - d12 * d12;
-                let b1 = (d22 * q1 - d12 * q2) / det;
-                let b2 = (d11 * q2 - d12 * q1) / det;
+                let (t, b1, b2) = triangle_plane_hit(&p, x, d)?;
                 let n_s = (n[0] * (1.0 - b1 - b2) + n[1] * b1 + n[2] * b2).normalize_or_zero();
                 (n_s != DVec3::ZERO).then_some((t, x + d * t, n_s))
             }

@@ -179,22 +179,7 @@ enum Converged {
 /// ([`converge`]'s line search); spheres always cast.
 fn stays_on(patch: &Patch, x_j: DVec3, d: DVec3) -> bool {
     let Surface::Triangle { p, .. } = patch.surface else { return false };
-    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-    let ng = e1.cross(e2);
-    let denom = d.dot(ng);
-    if denom == 0.0 {
-        return false;
-    }
-    let t = (p[0] - x_j).dot(ng) / denom;
-    if !(t > 0.0) {
-        return false;
-    }
-    let q = x_j + d * t - p[0];
-    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
-    let (q1, q2) = (q.dot(e1), q.dot(e2));
-    let det = d11 * d22 - d12 * d12;
-    let b1 = (d22 * q1 - d12 * q2) / det;
-    let b2 = (d11 * q2 - d12 * q1) / det;
+    let Some((_, b1, b2)) = super::newton::triangle_plane_hit(&p, x_j, d) else { return false };
     b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0
 }
 
