@@ -168,7 +168,10 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         bounds,
         emitters_unreachable: Vec::new(),
         surfaces_block_shadow_rays: false,
+        only_area_emitters: false,
     };
+    scene.only_area_emitters =
+        !scene.emitters.is_empty() && scene.emitters.iter().all(|e| matches!(e, SceneEmitter::Area { .. }));
     scene.emitters_unreachable = integrator::enclosure::emitters_unreachable(&scene);
     scene.surfaces_block_shadow_rays = integrator::enclosure::surfaces_block_shadow_rays(&scene);
     scene.integrator = integrator::build(integrator, &scene);

@@ -48,6 +48,9 @@ pub struct Scene {
     /// No surface lets a shadow ray through (no null, thindielectric or mask BSDF): shadow-ray
     /// transmittance needs one any-hit query (`integrator/enclosure.rs`).
     pub surfaces_block_shadow_rays: bool,
+    /// Every emitter is an area light (`SceneEmitter::Area`, sphere lights included) and there is
+    /// at least one: a uniform emitter pick always returns one.
+    pub only_area_emitters: bool,
 }
 
 impl Scene {
