@@ -181,23 +181,24 @@ pub fn sample(cx: &mut Cx, opts: SneeOptions, x_i: Option<&SneeVertex>, v: &Scat
     }
     stats.manifold_attempts += 1;
     // Where every emitter is an area light the pick below always takes the area-light connection,
-    // which runs only if `u_rate` is below its top rate (`curved_finite::connect`): that test is
-    // made first, with the same numbers, so that a vertex where the connection does not run picks
-    // no light point. The same decisions and images, bit for bit.
-    if scene.only_area_emitters {
+    // which runs only if `u_rate` is below its top rate (`curved_finite::connect`): that number is
+    // drawn and tested first, so that a vertex where the connection does not run picks no light
+    // point. The same numbers in the same order, so the same decisions and images, bit for bit.
+    let early_rate = if scene.only_area_emitters {
         let u_rate = sampler.next_1d() as f64;
         if u_rate >= super::curved_finite::rate(opts) {
             return Some(Spectrum::ZERO);
         }
-        let super::finite::Pick::Finite(lp) = super::finite::pick(scene, u) else { return Some(Spectrum::ZERO) };
-        return Some(super::curved_finite::sample(scene, opts, x_i, &x_j, &lp, u_rate, v.beta, channel, stats));
-    }
+        Some(u_rate)
+    } else {
+        None
+    };
     // The same emitter choice as the flat connection: directional lights here, area and sphere
     // lights in `curved_finite.rs` (docs/manifold.md §8.2), nothing else.
     match super::finite::pick(scene, u) {
         super::finite::Pick::Distant => {}
         super::finite::Pick::Finite(lp) if lp.area.is_some() => {
-            let u_rate = sampler.next_1d() as f64;
+            let u_rate = early_rate.unwrap_or_else(|| sampler.next_1d() as f64);
             return Some(super::curved_finite::sample(scene, opts, x_i, &x_j, &lp, u_rate, v.beta, channel, stats));
         }
         _ => return Some(Spectrum::ZERO),

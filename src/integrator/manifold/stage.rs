@@ -22,6 +22,7 @@ use crate::color::Spectrum;
 use crate::integrator::cx::Cx;
 use crate::integrator::cx::Scatter;
 use crate::integrator::snee::passable;
+use crate::integrator::snee::stage::{shift, take_some};
 use crate::integrator::snee::{Snee, SneeStage, SneeVertex};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::DirectionSample;
@@ -100,14 +101,8 @@ impl<'a> ManifoldStage<'a> {
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.arrived = self.tracker.surface_event();
-        // The pending records are mostly `None` on both sides: then nothing is moved (each holds a
-        // whole `SurfaceInteraction`).
-        if self.rough_pending.is_some() || self.rough_arrived.is_some() {
-            self.rough_arrived = self.rough_pending.take();
-        }
-        if self.curved_pending.is_some() || self.curved_arrived.is_some() {
-            self.curved_arrived = self.curved_pending.take();
-        }
+        shift(&mut self.rough_arrived, &mut self.rough_pending);
+        shift(&mut self.curved_arrived, &mut self.curved_pending);
         // `hit` is read only with a record that arrived or after a medium vertex `x_j` (`weight`,
         // `nee_weight`); otherwise it is not copied and keeps no meaning.
         let read = self.arrived.is_some()
@@ -154,15 +149,5 @@ impl<'a> ManifoldStage<'a> {
         self.curved_pending =
             curved_finite::pending(scene, self.x_i, self.tracker.x_j, s, bs, wo, take_some(&mut self.curved_arrived));
         self.tracker.after_bsdf(scene, s, bs.sampled_type, wo, take_some(&mut self.arrived));
-    }
-}
-
-/// `o.take()` that moves nothing when `o` is `None` (the records are large and mostly `None`).
-#[inline(always)]
-fn take_some<T>(o: &mut Option<T>) -> Option<T> {
-    if o.is_some() {
-        o.take()
-    } else {
-        None
     }
 }

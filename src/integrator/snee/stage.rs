@@ -91,10 +91,7 @@ impl<'a> SneeStage<'a> {
             (Some((x_i, x_j)), Some(s)) if encloses(scene, s, x_i.medium, d) => Some(SneeSuffix { x_i, x_j, si_k: *s }),
             _ => None,
         };
-        // Both are mostly `None`: then nothing is moved (a suffix holds a whole `SurfaceInteraction`).
-        if self.pending.is_some() || self.arrived.is_some() {
-            self.arrived = self.pending.take();
-        }
+        shift(&mut self.arrived, &mut self.pending);
     }
 
     /// The weight of a forward contribution with volpath weight `w_volpath`: an emitter hit by
@@ -139,5 +136,25 @@ impl<'a> SneeStage<'a> {
         } else if !non_null && passable(scene, s) {
             self.pending = self.arrived;
         }
+    }
+}
+
+/// `*arrived = pending.take()`, moving nothing when both are `None`: the stages' pending records
+/// (SNEE's suffix, the manifold connections') each hold a whole `SurfaceInteraction` and are mostly
+/// `None`.
+#[inline(always)]
+pub fn shift<T>(arrived: &mut Option<T>, pending: &mut Option<T>) {
+    if pending.is_some() || arrived.is_some() {
+        *arrived = pending.take();
+    }
+}
+
+/// `o.take()` that moves nothing when `o` is `None` (for the same records as [`shift`]).
+#[inline(always)]
+pub fn take_some<T>(o: &mut Option<T>) -> Option<T> {
+    if o.is_some() {
+        o.take()
+    } else {
+        None
     }
 }
