@@ -52,9 +52,9 @@ pub const MIN_DEPTH_FACTOR: f64 = 1e-3;
 /// spread evenly along a chord of optical length `τ` (`snee::rate::mean_depth_factor`); `None`
 /// where it serves no medium (the caller then keeps `RATE`). So the connection runs at about `q̄`
 /// attempts per medium vertex whatever the medium's thickness (docs/manifold.md §8.2, "Thin
-/// media"): in a thin medium every vertex is shallow and the depth factor no longer thins the
+/// media"): in a thin medium every vertex is shallow and the depth factor does not thin the
 /// attempts (an attempt costs ~100 ray casts), so the top rate falls; in a thick one (`τ` ≥ ~15)
-/// it is `RATE`, as before. A function of the scene only, decided at load.
+/// it is `RATE`. A function of the scene only, decided at load.
 pub fn default_top_rate(scene: &Scene, curved: &[bool]) -> Option<f64> {
     use crate::integrator::snee::rate::{mean_depth_factor, optical_size, CONNECTION_MEAN_RATE};
     (0u32..)

@@ -108,7 +108,7 @@ pub fn optical_size(scene: &Scene, medium: u32) -> f32 {
 /// ~100 ray casts (12 Newton solves and their verification, §8.2), so 1/256 keeps its expected cost
 /// under half a ray cast per vertex, against volpath's ~2 per sample. Chosen from that cost, not from
 /// renders; in a thick medium (`τ` ≥ ~15) the top rate it gives reaches `curved_finite::RATE` and
-/// the former rate stands.
+/// `RATE` stands.
 pub const CONNECTION_MEAN_RATE: f64 = 1.0 / 256.0;
 
 /// `m(τ) = (1 − e^{−τ})/τ`: the mean of `e^{−σ_t t}` for `t` uniform along a chord of optical length
