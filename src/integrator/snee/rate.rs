@@ -105,7 +105,7 @@ pub fn optical_size(scene: &Scene, medium: u32) -> f32 {
 /// The curved area-light connection's mean rate (docs/manifold.md §8.2, "Thin media"): its expected
 /// attempts per medium vertex for vertices spread evenly through the medium, which
 /// `manifold::curved_finite::default_top_rate` holds fixed across optical sizes. An attempt costs
-/// ~100 ray casts (12 Newton solves and their verification, §8.2), so 1/256 keeps its expected cost
+/// up to ~100 ray casts (the Newton solves from `newton_point::SEEDS` seeds and their verification, §8.2), so 1/256 keeps its expected cost
 /// under half a ray cast per vertex, against volpath's ~2 per sample. Chosen from that cost, not from
 /// renders; in a thick medium (`τ` ≥ ~15) the top rate it gives reaches `curved_finite::RATE` and
 /// `RATE` stands.
