@@ -276,7 +276,8 @@ macro_rules! closest_body {
         let (bvh, mut tmax, stack): (&Bvh8, f32, &mut Stack) = ($bvh, $tmax, $stack);
         let tr = TraceRay::new($o, $d);
         let (nr, wt) = (&tr.node, &tr.wt);
-        let mut found = None;
+        // The nearest hit so far: its lane (`u32::MAX` while none) and barycentrics; its distance is `tmax`.
+        let (mut hit_lane, mut hit_b1, mut hit_b2) = (u32::MAX, 0.0f32, 0.0f32);
         let mut sp = 0usize;
         let mut cur = bvh.root;
         let mut t_near = [0.0f32; 8];
@@ -314,14 +315,13 @@ macro_rules! closest_body {
             if cur != EMPTY {
                 let packet = (cur & !LEAF) as usize;
                 if let Some((lane, t, b1, b2)) = wt.nearest4(at!($chk, bvh.packets, packet), tmax) {
-                    tmax = t;
-                    found = Some(((4 * packet + lane) as u32, t, b1, b2));
+                    (hit_lane, tmax, hit_b1, hit_b2) = ((4 * packet + lane) as u32, t, b1, b2);
                 }
             }
             // Pop the nearest remaining child that may still hold a closer hit.
             loop {
                 if sp == 0 {
-                    break 'traversal found;
+                    break 'traversal (hit_lane != u32::MAX).then_some((hit_lane, tmax, hit_b1, hit_b2));
                 }
                 sp -= 1;
                 // SAFETY: entries below `sp` were written.

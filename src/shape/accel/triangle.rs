@@ -74,16 +74,21 @@ pub struct WatertightRay {
 }
 
 /// The edge functions recomputed in `f64` (Woop et al. 2013, Sec. 3.3) in the lanes of `lanes`,
-/// the `f32` ones `uvw` elsewhere; `p` holds the sheared (ax, ay, bx, by, cx, cy).
-#[inline(always)]
-fn edges_f64(lanes: u32, p: [Vec4; 6], uvw: [Vec4; 3]) -> (Vec4, Vec4, Vec4) {
-    let (ax, ay, bx, by) = (p[0].as_dvec4(), p[1].as_dvec4(), p[2].as_dvec4(), p[3].as_dvec4());
-    let (cx, cy) = (p[4].as_dvec4(), p[5].as_dvec4());
+/// the `f32` ones `uvw` elsewhere. Rare (the ray meets an edge or vertex in float precision), so
+/// out of line: it shears the packet's vertices again (the same operations, so the same bits)
+/// rather than have the test keep the sheared coordinates alive across the branch, which would
+/// spill them on every leaf visit.
+#[cold]
+#[inline(never)]
+fn edges_f64(ray: WatertightRay, p: &TriPacket4, lanes: u32, uvw: [Vec4; 3]) -> [Vec4; 3] {
+    let ((ax, ay, _), (bx, by, _), (cx, cy, _)) = (sheared(&ray, p, 0), sheared(&ray, p, 1), sheared(&ray, p, 2));
+    let (ax, ay, bx, by) = (ax.as_dvec4(), ay.as_dvec4(), bx.as_dvec4(), by.as_dvec4());
+    let (cx, cy) = (cx.as_dvec4(), cy.as_dvec4());
     let u = (cx * by - cy * bx).as_vec4();
     let v = (ax * cy - ay * cx).as_vec4();
     let w = (bx * ay - by * ax).as_vec4();
     let m = glam::BVec4A::new(lanes & 1 != 0, lanes & 2 != 0, lanes & 4 != 0, lanes & 8 != 0);
-    (Vec4::select(m, u, uvw[0]), Vec4::select(m, v, uvw[1]), Vec4::select(m, w, uvw[2]))
+    [Vec4::select(m, u, uvw[0]), Vec4::select(m, v, uvw[1]), Vec4::select(m, w, uvw[2])]
 }
 
 /// Sheared vertex coordinates (x, y, z) of one vertex in the four lanes.
@@ -172,7 +177,7 @@ impl WatertightRay {
             // An edge function exactly 0 (the ray meets an edge or vertex in float precision):
             // recompute that lane's three in double precision, as the paper does (all four lanes
             // at once, kept only where needed; the same products and roundings as scalar code).
-            (u, v, w) = edges_f64(exact_zero, [ax, ay, bx, by, cx, cy], [u, v, w]);
+            [u, v, w] = edges_f64(*self, p, exact_zero, [u, v, w]);
         }
         let neg = (u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero)).bitmask();
         let pos = (u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero)).bitmask();
