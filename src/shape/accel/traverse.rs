@@ -75,8 +75,7 @@ impl TraceRay {
         // Opaque to the optimiser, which would otherwise turn `b + (−o)` back into `b − o`.
         let neg_o = std::hint::black_box(-o);
         let node = NodeRay::with_inverse(neg_o, d0, inv);
-        let neg = d0.cmplt(Vec4::ZERO).bitmask() & 7;
-        TraceRay { node, wt: WatertightRay::with_inverse_octant(neg_o, d, inv, neg) }
+        TraceRay { node, wt: WatertightRay::with_inverse_d0(neg_o, d, d0, inv) }
     }
 }
 

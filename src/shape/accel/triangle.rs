@@ -7,7 +7,7 @@
 //! it the ray passes: no ray slips between them.
 
 use crate::math::Vec3;
-use glam::Vec4;
+use glam::{Vec4, Vec4Swizzles};
 
 /// Four triangles, one lane each: `v[vertex][axis][lane]`. An unused lane holds NaN vertices,
 /// which never report a hit.
@@ -55,9 +55,36 @@ pub fn shear_axes(d: Vec3) -> ([usize; 3], [f32; 3]) {
     ([kx, ky, kz], [d[kx] * sz, d[ky] * sz, sz])
 }
 
-/// `(kx, ky)` of [`shear_axes`] by row `2 · kz + (d[kz] < 0)`: the axes following `kz`, swapped
-/// when `d[kz]` is negative.
-const AXES: [[u8; 2]; 6] = [[1, 2], [2, 1], [2, 0], [0, 2], [0, 1], [1, 0]];
+/// `(kx, ky, kz)` of [`shear_axes`] by row `octant | cmp << 3`: `octant` holds the signs of the
+/// direction (bit `a` set when `d[a] < 0`) and `cmp` the comparisons of its magnitudes
+/// (|dx| > |dy|, |dx| > |dz|, |dy| > |dz| in bits 0, 1, 2), so one load replaces the branches of
+/// `shear_axes`. Rows of intransitive comparisons never occur.
+const AXES: [[u8; 3]; 64] = axes_table();
+
+/// The rows of [`AXES`], by `shear_axes`'s rule.
+const fn axes_table() -> [[u8; 3]; 64] {
+    let mut t = [[0; 3]; 64];
+    let mut row = 0;
+    while row < 64 {
+        let (octant, cmp) = (row & 7, row >> 3);
+        // a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2).
+        let kz = if cmp & 1 != 0 {
+            if cmp & 2 != 0 {
+                0
+            } else {
+                2
+            }
+        } else if cmp & 4 != 0 {
+            1
+        } else {
+            2
+        };
+        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        t[row] = if (octant >> kz) & 1 != 0 { [ky, kx, kz] } else { [kx, ky, kz] };
+        row += 1;
+    }
+    t
+}
 
 /// Per-ray precomputation of the watertight test (Woop et al. 2013, Sec. 3).
 #[derive(Clone, Copy, Debug)]
@@ -127,23 +154,21 @@ impl WatertightRay {
     /// infinity when `d` is zero, where every lane is NaN and misses either way).
     #[inline(always)]
     pub fn with_inverse(neg_o: Vec3, d: Vec3, inv: Vec4) -> Self {
-        let neg = (d + Vec3::ZERO).cmplt(Vec3::ZERO).bitmask();
-        Self::with_inverse_octant(neg_o, d, inv, neg)
+        Self::with_inverse_d0(neg_o, d, Vec4::new(d.x, d.y, d.z, 1.0) + Vec4::ZERO, inv)
     }
 
-    /// [`WatertightRay::with_inverse`] given also `neg`, the sign bits of `d + 0` (bit `a` set when
-    /// `d[a] < 0`; the node test's octant). The axes come from one table row: the dominant axis
-    /// `kz` and the sign of `d[kz]` (a zero `d[kz]`, i.e. `d` zero, counts as positive, as
-    /// `d[kz] < 0.0` does for ±0).
+    /// [`WatertightRay::with_inverse`] given also `d0` = d + 0 as a vector (its w lane unused), as
+    /// the node test has it. The axes come from one row of [`AXES`], by the signs of `d0` (the node
+    /// test's octant; a zero `d[kz]`, i.e. `d` zero, counts as positive, as `d[kz] < 0.0` does for
+    /// ±0) and one vector comparison of its magnitudes.
     #[inline(always)]
-    pub fn with_inverse_octant(neg_o: Vec3, d: Vec3, inv: Vec4, neg: u32) -> Self {
-        let a = d.abs();
-        let (xy, xz, yz) = ((a.x > a.y) as usize, (a.x > a.z) as usize, (a.y > a.z) as usize);
-        // shear_axes: a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2).
-        let kz = if xy != 0 { 2 - 2 * xz } else { 2 - yz };
-        let [kx, ky] = AXES[2 * kz + ((neg >> kz) & 1) as usize].map(usize::from);
+    pub fn with_inverse_d0(neg_o: Vec3, d: Vec3, d0: Vec4, inv: Vec4) -> Self {
+        let octant = d0.cmplt(Vec4::ZERO).bitmask() & 7;
+        let a = d0.abs();
+        let cmp = a.xxyw().cmpgt(a.yzzw()).bitmask() & 7;
+        let [kx, ky, kz] = AXES[(octant | cmp << 3) as usize].map(usize::from);
         let (d, o, inv) = (d.to_array(), neg_o.to_array(), inv.to_array());
-        // SAFETY: `kx`, `ky` (rows of `AXES`) and `kz` are below 3.
+        // SAFETY: `kx`, `ky` and `kz` (a row of `AXES`) are below 3.
         let (dx, dy, ox, oy, oz, sz) = unsafe {
             (
                 d.get_unchecked(kx),
