@@ -285,6 +285,7 @@ mod tests;
 /// `x − x` is exactly 0 for a finite `x` and NaN otherwise, so the three differences sum to 0 exactly
 /// when every component is finite: one comparison instead of one per component.
 #[inline(always)]
+#[allow(clippy::eq_op)] // `s - s` is the finiteness test, not zero
 fn ray_is_finite(ray: &Ray) -> bool {
     let s = ray.o + ray.d;
     let z = s - s;

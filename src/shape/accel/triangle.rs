@@ -122,7 +122,7 @@ fn edges_f64(ray: WatertightRay, p: &TriPacket4, lanes: u32, uvw: [Vec4; 3]) -> 
 #[inline(always)]
 fn sheared(w: &WatertightRay, p: &TriPacket4, j: usize) -> (Vec4, Vec4, Vec4) {
     let v = &p.v[j];
-    // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse_octant`),
+    // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse_d0`),
     // so the four floats from each offset are one row of `v`.
     let row = |k: usize| unsafe { Vec4::from_array(*v.as_ptr().cast::<f32>().add(k).cast::<[f32; 4]>()) };
     let rx = row(w.k[0]) + Vec4::splat(w.neg_o.x);
