@@ -61,6 +61,8 @@ pub struct Accel {
     /// Shapes tested outside the BVH (spheres, disks).
     analytic: Vec<Analytic>,
     isa: Isa,
+    /// The tree is too deep for the fixed traversal stack (`traverse::STACK`): queries use a heap one.
+    deep: bool,
 }
 
 /// A shape tested outside the BVH, with what its test needs copied out of the shape.
@@ -113,7 +115,8 @@ impl Accel {
                 _ => unreachable!("only meshes are in the BVH"),
             }
         });
-        Accel { bvh, analytic, isa }
+        let deep = bvh.as_ref().is_some_and(|b| traverse::stack_size(b.depth) > STACK);
+        Accel { bvh, analytic, isa, deep }
     }
 
     /// Bytes of the BVH (nodes, triangle packets, per-lane shape and triangle).
@@ -186,7 +189,7 @@ impl Accel {
     /// ray's precomputation happens inside it).
     #[inline(always)]
     fn closest(&self, bvh: &Bvh8, ray: &Ray, tmax: f32) -> Option<(u32, f32, f32, f32)> {
-        if traverse::stack_size(bvh.depth) > STACK {
+        if self.deep {
             return closest_deep(bvh, ray, tmax, self.isa);
         }
         let stack = &mut [const { MaybeUninit::uninit() }; STACK];
@@ -200,7 +203,7 @@ impl Accel {
 
     #[inline(always)]
     fn any(&self, bvh: &Bvh8, ray: &Ray) -> bool {
-        if traverse::stack_size(bvh.depth) > STACK {
+        if self.deep {
             return any_deep(bvh, ray, self.isa);
         }
         let stack = &mut [const { MaybeUninit::uninit() }; STACK];
