@@ -14,14 +14,15 @@
 use super::mesh_data::MeshData;
 use super::{obj, ply, serialized, Geometry};
 use crate::emitter::distribution::Distribution1D;
-use crate::interaction::{shading_frame, PositionSample, SurfaceInteraction};
+use crate::interaction::{shading_frame_a, PositionSample, SurfaceInteraction};
 use crate::math::{warp, Aabb, Frame, Mat4, Vec2, Vec3};
 use crate::scene::desc::ObjectDesc;
 use crate::scene::resolver::FileResolver;
 use crate::scene::{Error, Result};
+use glam::Vec3A;
 use rayon::prelude::*;
 
-/// Largest mesh (triangles) that stores a shading frame per triangle (36 bytes each, 9 MB at most).
+/// Largest mesh (triangles) that stores a shading frame per triangle (48 bytes each, 12 MB at most).
 pub const MAX_FACE_FRAMES: usize = 1 << 18;
 /// Largest mesh (triangles) that stores its triangles for area sampling (72 bytes each, 1.2 MB at
 /// most): area lights are rectangles, cubes and small meshes; larger ones read the vertex arrays.
@@ -56,8 +57,9 @@ pub struct Mesh {
     /// The shading frame of each triangle when it is the same at every point of every triangle
     /// (no vertex normals, or the three vertex normals of each triangle equal, as on `rectangle`,
     /// `cube` and flat-shaded files) and the mesh has at most [`MAX_FACE_FRAMES`] triangles;
-    /// empty otherwise (then it is computed per hit).
-    face_frames: Vec<Frame>,
+    /// empty otherwise (then it is computed per hit). Stored as `[s, t, n]` in 16-byte vectors,
+    /// as the hit record computes with them.
+    face_frames: Vec<[Vec3A; 3]>,
     /// Per triangle, what area sampling reads (meshes up to [`MAX_SAMPLE_TRIANGLES`]; else empty).
     sample_triangles: Vec<SampleTriangle>,
     /// Triangles by area (alias table, for area sampling).
@@ -148,17 +150,17 @@ impl Mesh {
         (n, dp_du)
     }
 
-    /// The shading normal at barycentrics (b0, b1, b2) of triangle `prim`: the interpolated vertex
+    /// The shading normal at barycentrics (b0, b1, b2) of the triangle with vertices `idx`: the interpolated vertex
     /// normal (flipped with `flip_normals`), or the geometric normal `n` without vertex normals or
     /// where the interpolation vanishes.
     #[inline(always)]
-    fn shading_normal(&self, prim: u32, n: Vec3, b0: f32, b1: f32, b2: f32) -> Vec3 {
+    fn shading_normal(&self, idx: [u32; 3], n: Vec3A, b0: f32, b1: f32, b2: f32) -> Vec3A {
         if self.normals.is_empty() {
             return n;
         }
-        let [n0, n1, n2] = self.indices[prim as usize].map(|i| self.normals[i as usize]);
+        let [n0, n1, n2] = idx.map(|i| Vec3A::from(self.normals[i as usize]));
         let sh_n = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
-        if sh_n == Vec3::ZERO {
+        if sh_n == Vec3A::ZERO {
             n
         } else if self.flip_normals {
             -sh_n
@@ -171,7 +173,7 @@ impl Mesh {
     /// `face_frames`), else empty. With equal vertex normals the frame is built from the vertex
     /// normal itself: the interpolation `normalize(b0 n + b1 n + b2 n)` is the same vector up to
     /// rounding.
-    fn flat_frames(&self) -> Vec<Frame> {
+    fn flat_frames(&self) -> Vec<[Vec3A; 3]> {
         if self.indices.len() > MAX_FACE_FRAMES {
             return Vec::new();
         }
@@ -187,7 +189,7 @@ impl Mesh {
             .into_par_iter()
             .map(|prim| {
                 let (n, dp_du) = self.normal_and_dp_du(prim);
-                shading_frame(self.shading_normal(prim, n, 1.0, 0.0, 0.0), dp_du)
+                shading_frame_a(self.shading_normal(self.indices[prim as usize], n.into(), 1.0, 0.0, 0.0), dp_du.into())
             })
             .collect()
     }
@@ -235,11 +237,18 @@ impl Mesh {
     }
 
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
+    ///
+    /// Computed in 16-byte vectors (`Vec3A`: whole-register arithmetic instead of the shuffles
+    /// that 12-byte `Vec3`s need), with the same operations in the same order as the `Vec3` forms
+    /// ([`Mesh::point_and_normal`], [`shading_frame`], `Frame::to_local`): the same record bit for bit.
     #[inline(always)]
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
         let idx = self.indices[prim as usize];
-        let (p, n) = self.point_and_normal(prim, b1, b2);
+        let [p0, p1, p2] = idx.map(|i| Vec3A::from(self.positions[i as usize]));
         let b0 = 1.0 - b1 - b2;
+        let p = p0 * b0 + p1 * b1 + p2 * b2;
+        let face_n = self.face_normals[prim as usize];
+        let n = if self.flip_normals { -face_n } else { face_n };
         let uv = if !self.hit_uv {
             Vec2::ZERO
         } else if self.uvs.is_empty() {
@@ -248,14 +257,24 @@ impl Mesh {
             let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
             u0 * b0 + u1 * b1 + u2 * b2
         };
-        let sh_frame = match self.face_frames.get(prim as usize) {
+        let [sh_s, sh_t, sh_n] = match self.face_frames.get(prim as usize) {
             Some(frame) => *frame,
             None => {
-                let (n, dp_du) = self.normal_and_dp_du(prim);
-                shading_frame(self.shading_normal(prim, n, b0, b1, b2), dp_du)
+                // dp/du as `normal_and_dp_du` computes it.
+                let dp_du = if self.uvs.is_empty() {
+                    p1 - p0
+                } else {
+                    let dp_du = self.face_dp_du[prim as usize];
+                    Vec3A::from(if dp_du == Vec3::ZERO { Frame::from_normal(face_n).s } else { dp_du })
+                };
+                shading_frame_a(self.shading_normal(idx, n.into(), b0, b1, b2), dp_du)
             }
         };
-        SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray_d), shape: 0, prim }
+        // `Frame::to_local(-ray_d)`.
+        let v = -Vec3A::from(ray_d);
+        let wi = Vec3::new(v.dot(sh_s), v.dot(sh_t), v.dot(sh_n));
+        let sh_frame = Frame { s: sh_s.into(), t: sh_t.into(), n: sh_n.into() };
+        SurfaceInteraction { t, p: p.into(), n, sh_frame, uv, wi, shape: 0, prim }
     }
 
     /// Uniform by area: pick a triangle by area, then a uniform point on it, `p0 + e0 b1 + e1 b2`
