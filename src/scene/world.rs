@@ -51,6 +51,9 @@ pub struct Scene {
     /// Every emitter is an area light (`SceneEmitter::Area`, sphere lights included) and there is
     /// at least one: a uniform emitter pick always returns one.
     pub only_area_emitters: bool,
+    /// Per emitter: centre and `r²` of a constant sphere light with outward normals, else `None`
+    /// (`integrator::volpath::constant_sphere_lights`; what its emitter-skip test reads).
+    pub constant_sphere_lights: Vec<Option<(Vec3, f32)>>,
 }
 
 impl Scene {
