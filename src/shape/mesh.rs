@@ -391,6 +391,96 @@ pub fn from_file_props(
 mod tests {
     use crate::shape::Geometry;
 
+    /// The hit record of `Mesh::interaction` (computed in `Vec3A`) is the `Vec3` arithmetic it
+    /// stands for, bit for bit: point, normal, shading frame (Gram–Schmidt of dp/du against the
+    /// interpolated normal, `interaction::shading_frame`) and `wi`, on a smooth mesh (per-hit frames)
+    /// and a flat one (frames stored at load), with and without uvs and `flip_normals`.
+    #[test]
+    fn hit_record_is_the_vec3_arithmetic_bit_for_bit() {
+        use super::{Mesh, MeshData};
+        use crate::math::{Frame, Mat4, Vec2, Vec3};
+        // A 6×6 grid bent into a bump, vertex normals tilted per vertex (or none: flat).
+        let (w, h) = (6u32, 6u32);
+        let mut data = MeshData::default();
+        for j in 0..h {
+            for i in 0..w {
+                let (x, z) = (i as f32 * 0.37 - 0.9, j as f32 * 0.29 - 0.7);
+                data.positions.push(Vec3::new(x, 0.3 * (x * 2.1).sin() * (z * 1.7).cos(), z));
+                data.normals.push(Vec3::new(0.2 * x, 1.0, -0.3 * z * x).normalize());
+                data.uvs.push(Vec2::new(i as f32 * 0.21 + 0.1 * j as f32, j as f32 * 0.17));
+            }
+        }
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let v = j * w + i;
+                data.indices.push([v, v + 1, v + w]);
+                data.indices.push([v + 1, v + w + 1, v + w]);
+            }
+        }
+        data.uvs[7] = data.uvs[8]; // a degenerate uv triangle: dp/du from the face normal
+        let mut sampler = crate::sampler::Sampler::new(7, 0);
+        for (normals, uvs, flip) in
+            [(true, false, false), (true, true, true), (false, false, true), (false, true, false)]
+        {
+            let d = MeshData { uvs: if uvs { data.uvs.clone() } else { Vec::new() }, ..data.clone() };
+            // Without normals: `face_normals` (else the mesh recomputes smooth vertex normals).
+            let mesh = Mesh::new(d, &Mat4::IDENTITY, !normals, flip);
+            assert_eq!(mesh.face_frames.is_empty(), normals);
+            for _ in 0..2000 {
+                let prim = ((sampler.next_1d() * mesh.indices.len() as f32) as u32).min(mesh.indices.len() as u32 - 1);
+                let (mut b1, mut b2) = (sampler.next_1d(), sampler.next_1d());
+                if b1 + b2 > 1.0 {
+                    (b1, b2) = (1.0 - b1, 1.0 - b2);
+                }
+                let dir = Vec3::new(sampler.next_1d() - 0.5, -1.0, sampler.next_1d() - 0.5).normalize();
+                let si = mesh.interaction(prim, b1, b2, 1.5, dir);
+                // The reference, in `Vec3`.
+                let idx = mesh.indices[prim as usize];
+                let [p0, p1, p2] = idx.map(|i| mesh.positions[i as usize]);
+                let b0 = 1.0 - b1 - b2;
+                let p = p0 * b0 + p1 * b1 + p2 * b2;
+                let face_n = mesh.face_normals[prim as usize];
+                let n = if flip { -face_n } else { face_n };
+                let dp_du = match mesh.face_dp_du.get(prim as usize) {
+                    None => p1 - p0,
+                    Some(&dp_du) if dp_du == Vec3::ZERO => Frame::from_normal(face_n).s,
+                    Some(&dp_du) => dp_du,
+                };
+                let sh_n = if mesh.normals.is_empty() {
+                    n
+                } else {
+                    let [n0, n1, n2] = idx.map(|i| mesh.normals[i as usize]);
+                    let v = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
+                    if v == Vec3::ZERO {
+                        n
+                    } else if flip {
+                        -v
+                    } else {
+                        v
+                    }
+                };
+                let s = dp_du - sh_n * sh_n.dot(dp_du);
+                let len2 = s.length_squared();
+                let frame = if len2 > 0.0 && len2.is_finite() {
+                    let s = s / len2.sqrt();
+                    Frame { s, t: sh_n.cross(s), n: sh_n }
+                } else {
+                    Frame::from_normal(sh_n)
+                };
+                let v = -dir;
+                let wi = Vec3::new(v.dot(frame.s), v.dot(frame.t), v.dot(frame.n));
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                let case = format!("normals {normals} uvs {uvs} flip {flip} prim {prim} b ({b1}, {b2})");
+                assert_eq!(bits(si.p), bits(p), "p: {case}");
+                assert_eq!(bits(si.n), bits(n), "n: {case}");
+                assert_eq!(bits(si.sh_frame.s), bits(frame.s), "s: {case}");
+                assert_eq!(bits(si.sh_frame.t), bits(frame.t), "t: {case}");
+                assert_eq!(bits(si.sh_frame.n), bits(frame.n), "sh_n: {case}");
+                assert_eq!(bits(si.wi), bits(wi), "wi: {case}");
+            }
+        }
+    }
+
     #[test]
     fn hit_uv_skipped_only_where_no_texture_reads_it() {
         let xml = r#"<scene version="3.0.0">
