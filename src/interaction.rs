@@ -2,6 +2,7 @@
 //! (Mitsuba's `SurfaceInteraction3f`, `DirectionSample3f`, `PositionSample3f`).
 
 use crate::math::{Frame, Ray, Vec2, Vec3};
+use glam::Vec3A;
 
 /// Relative ray offset (Mitsuba's `math::RayEpsilon` = 1500 ulp at 1).
 pub const RAY_EPSILON: f32 = f32::EPSILON * 0.5 * 1500.0;
@@ -56,13 +57,22 @@ impl SurfaceInteraction {
 /// `coordinate_system`).
 #[inline]
 pub fn shading_frame(n: Vec3, dp_du: Vec3) -> Frame {
+    let [s, t, n] = shading_frame_a(n.into(), dp_du.into());
+    Frame { s: s.into(), t: t.into(), n: n.into() }
+}
+
+/// [`shading_frame`] on 16-byte vectors, as `[s, t, n]` (the mesh hit record computes in them):
+/// the same operations in the same order, so the same frame bit for bit.
+#[inline(always)]
+pub fn shading_frame_a(n: Vec3A, dp_du: Vec3A) -> [Vec3A; 3] {
     let s = dp_du - n * n.dot(dp_du);
     let len2 = s.length_squared();
     if !(len2 > 0.0 && len2.is_finite()) {
-        return Frame::from_normal(n);
+        let f = Frame::from_normal(n.into());
+        return [f.s.into(), f.t.into(), n];
     }
     let s = s / len2.sqrt();
-    Frame { s, t: n.cross(s), n }
+    [s, n.cross(s), n]
 }
 
 /// Offset a surface point along its geometric normal `n`, to the side that `d` points to

@@ -84,7 +84,8 @@ pub fn skip_sample_emitter(scene: &Scene, p: Vec3, sampler: &mut Sampler) {
 
 /// True when `Scene::sample_emitter_direction(p, None, u, false)` certainly returns a usable
 /// sample (`pdf > 0` and a finite, non-zero weight); false when that is not sure (the caller then
-/// samples). Certain, with margins far above `f32` rounding, for the emitter `u.x` selects being an
+/// samples; which emitters qualify is decided at build, `constant_sphere_lights`). Certain, with
+/// margins far above `f32` rounding, for the emitter `u.x` selects being an
 /// `area` emitter of constant, finite radiance (some channel ≥ 1e-10) on a sphere with outward
 /// normals, seen from a point `p`
 /// - outside it by 1 % of `r²` (`Sphere::sample_direction` samples the subtended cone),
@@ -95,17 +96,25 @@ pub fn skip_sample_emitter(scene: &Scene, p: Vec3, sampler: &mut Sampler) {
 #[inline]
 fn surely_usable(scene: &Scene, p: Vec3, u: Vec2) -> bool {
     let Some((index, _)) = scene.select_emitter(u) else { return false };
-    let SceneEmitter::Area { shape, radiance: Texture::Const(le) } = &scene.emitters[index] else {
-        return false;
-    };
-    let Geometry::Sphere(sphere) = &scene.shapes[*shape as usize].geometry else { return false };
-    if sphere.flip_normals || !crate::color::is_finite(*le) || !(le.abs().max_element() >= 1e-10) {
-        return false;
-    }
-    let dist2 = (sphere.center - p).length_squared();
-    let r2 = sphere.radius * sphere.radius;
+    let Some((center, r2)) = scene.constant_sphere_lights[index] else { return false };
+    let dist2 = (center - p).length_squared();
     let rim = 1.0 - u.y;
     dist2 > r2 * 1.01 && rim > 1e-3 && rim * r2 > 2e-5 * dist2
+}
+
+/// Per emitter, decided at scene build for [`surely_usable`]: the centre and `r²` of an `area`
+/// emitter of constant, finite radiance (some channel ≥ 1e-10) on a sphere with outward normals;
+/// `None` for any other emitter (`Scene::constant_sphere_lights`).
+pub fn constant_sphere_lights(scene: &Scene) -> Vec<Option<(Vec3, f32)>> {
+    let light = |e: &SceneEmitter| {
+        let SceneEmitter::Area { shape, radiance: Texture::Const(le) } = e else { return None };
+        let Geometry::Sphere(sphere) = &scene.shapes[*shape as usize].geometry else { return None };
+        if sphere.flip_normals || !crate::color::is_finite(*le) || !(le.abs().max_element() >= 1e-10) {
+            return None;
+        }
+        Some((sphere.center, sphere.radius * sphere.radius))
+    };
+    scene.emitters.iter().map(light).collect()
 }
 
 /// Transmittance along a shadow ray up to `ray.tmax`, through null / thin-dielectric interfaces

@@ -169,9 +169,11 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         emitters_unreachable: Vec::new(),
         surfaces_block_shadow_rays: false,
         only_area_emitters: false,
+        constant_sphere_lights: Vec::new(),
     };
     scene.only_area_emitters =
         !scene.emitters.is_empty() && scene.emitters.iter().all(|e| matches!(e, SceneEmitter::Area { .. }));
+    scene.constant_sphere_lights = integrator::volpath::constant_sphere_lights(&scene);
     scene.emitters_unreachable = integrator::enclosure::emitters_unreachable(&scene);
     scene.surfaces_block_shadow_rays = integrator::enclosure::surfaces_block_shadow_rays(&scene);
     scene.integrator = integrator::build(integrator, &scene);

@@ -12,7 +12,7 @@ use crate::sensor::film::Film;
 use crate::sensor::sampler_desc::SamplerDesc;
 use crate::sensor::Camera;
 use crate::shape::accel::Accel;
-use crate::shape::Shape;
+use crate::shape::{Geometry, Shape};
 use crate::texture::Texture;
 
 /// An emitter of the scene: an area light bound to a shape, or a standalone emitter.
@@ -51,6 +51,9 @@ pub struct Scene {
     /// Every emitter is an area light (`SceneEmitter::Area`, sphere lights included) and there is
     /// at least one: a uniform emitter pick always returns one.
     pub only_area_emitters: bool,
+    /// Per emitter: centre and `r²` of a constant sphere light with outward normals, else `None`
+    /// (`integrator::volpath::constant_sphere_lights`; what its emitter-skip test reads).
+    pub constant_sphere_lights: Vec<Option<(Vec3, f32)>>,
 }
 
 impl Scene {
@@ -58,9 +61,15 @@ impl Scene {
     #[inline]
     pub fn ray_intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
         let hit = self.accel.intersect_inline(&self.shapes, ray)?;
-        let mut si = self.shapes[hit.shape as usize].interaction(hit.prim, hit.b1, hit.b2, hit.t, ray);
-        si.shape = hit.shape;
-        Some(si)
+        // Each arm returns its record whole (built in the return slot, not copied there).
+        let shape = hit.shape;
+        match &self.shapes[shape as usize].geometry {
+            Geometry::Mesh(m) => {
+                Some(SurfaceInteraction { shape, ..m.interaction(hit.prim, hit.b1, hit.b2, hit.t, ray.d) })
+            }
+            Geometry::Sphere(s) => Some(SurfaceInteraction { shape, ..s.interaction(hit.t, ray) }),
+            Geometry::Disk(d) => Some(SurfaceInteraction { shape, ..d.interaction(hit.t, ray) }),
+        }
     }
 
     /// True when the segment is blocked.

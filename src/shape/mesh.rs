@@ -14,14 +14,15 @@
 use super::mesh_data::MeshData;
 use super::{obj, ply, serialized, Geometry};
 use crate::emitter::distribution::Distribution1D;
-use crate::interaction::{shading_frame, PositionSample, SurfaceInteraction};
+use crate::interaction::{shading_frame_a, PositionSample, SurfaceInteraction};
 use crate::math::{warp, Aabb, Frame, Mat4, Vec2, Vec3};
 use crate::scene::desc::ObjectDesc;
 use crate::scene::resolver::FileResolver;
 use crate::scene::{Error, Result};
+use glam::Vec3A;
 use rayon::prelude::*;
 
-/// Largest mesh (triangles) that stores a shading frame per triangle (36 bytes each, 9 MB at most).
+/// Largest mesh (triangles) that stores a shading frame per triangle (48 bytes each, 12 MB at most).
 pub const MAX_FACE_FRAMES: usize = 1 << 18;
 /// Largest mesh (triangles) that stores its triangles for area sampling (72 bytes each, 1.2 MB at
 /// most): area lights are rectangles, cubes and small meshes; larger ones read the vertex arrays.
@@ -56,8 +57,9 @@ pub struct Mesh {
     /// The shading frame of each triangle when it is the same at every point of every triangle
     /// (no vertex normals, or the three vertex normals of each triangle equal, as on `rectangle`,
     /// `cube` and flat-shaded files) and the mesh has at most [`MAX_FACE_FRAMES`] triangles;
-    /// empty otherwise (then it is computed per hit).
-    face_frames: Vec<Frame>,
+    /// empty otherwise (then it is computed per hit). Stored as `[s, t, n]` in 16-byte vectors,
+    /// as the hit record computes with them.
+    face_frames: Vec<[Vec3A; 3]>,
     /// Per triangle, what area sampling reads (meshes up to [`MAX_SAMPLE_TRIANGLES`]; else empty).
     sample_triangles: Vec<SampleTriangle>,
     /// Triangles by area (alias table, for area sampling).
@@ -148,17 +150,17 @@ impl Mesh {
         (n, dp_du)
     }
 
-    /// The shading normal at barycentrics (b0, b1, b2) of triangle `prim`: the interpolated vertex
+    /// The shading normal at barycentrics (b0, b1, b2) of the triangle with vertices `idx`: the interpolated vertex
     /// normal (flipped with `flip_normals`), or the geometric normal `n` without vertex normals or
     /// where the interpolation vanishes.
     #[inline(always)]
-    fn shading_normal(&self, prim: u32, n: Vec3, b0: f32, b1: f32, b2: f32) -> Vec3 {
+    fn shading_normal(&self, idx: [u32; 3], n: Vec3A, b0: f32, b1: f32, b2: f32) -> Vec3A {
         if self.normals.is_empty() {
             return n;
         }
-        let [n0, n1, n2] = self.indices[prim as usize].map(|i| self.normals[i as usize]);
+        let [n0, n1, n2] = idx.map(|i| Vec3A::from(self.normals[i as usize]));
         let sh_n = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
-        if sh_n == Vec3::ZERO {
+        if sh_n == Vec3A::ZERO {
             n
         } else if self.flip_normals {
             -sh_n
@@ -171,7 +173,7 @@ impl Mesh {
     /// `face_frames`), else empty. With equal vertex normals the frame is built from the vertex
     /// normal itself: the interpolation `normalize(b0 n + b1 n + b2 n)` is the same vector up to
     /// rounding.
-    fn flat_frames(&self) -> Vec<Frame> {
+    fn flat_frames(&self) -> Vec<[Vec3A; 3]> {
         if self.indices.len() > MAX_FACE_FRAMES {
             return Vec::new();
         }
@@ -187,7 +189,7 @@ impl Mesh {
             .into_par_iter()
             .map(|prim| {
                 let (n, dp_du) = self.normal_and_dp_du(prim);
-                shading_frame(self.shading_normal(prim, n, 1.0, 0.0, 0.0), dp_du)
+                shading_frame_a(self.shading_normal(self.indices[prim as usize], n.into(), 1.0, 0.0, 0.0), dp_du.into())
             })
             .collect()
     }
@@ -235,11 +237,18 @@ impl Mesh {
     }
 
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
+    ///
+    /// Computed in 16-byte vectors (`Vec3A`: whole-register arithmetic instead of the shuffles
+    /// that 12-byte `Vec3`s need), with the same operations in the same order as the `Vec3` forms
+    /// ([`Mesh::point_and_normal`], [`shading_frame`], `Frame::to_local`): the same record bit for bit.
     #[inline(always)]
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
         let idx = self.indices[prim as usize];
-        let (p, n) = self.point_and_normal(prim, b1, b2);
+        let [p0, p1, p2] = idx.map(|i| Vec3A::from(self.positions[i as usize]));
         let b0 = 1.0 - b1 - b2;
+        let p = p0 * b0 + p1 * b1 + p2 * b2;
+        let face_n = self.face_normals[prim as usize];
+        let n = if self.flip_normals { -face_n } else { face_n };
         let uv = if !self.hit_uv {
             Vec2::ZERO
         } else if self.uvs.is_empty() {
@@ -248,14 +257,24 @@ impl Mesh {
             let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
             u0 * b0 + u1 * b1 + u2 * b2
         };
-        let sh_frame = match self.face_frames.get(prim as usize) {
+        let [sh_s, sh_t, sh_n] = match self.face_frames.get(prim as usize) {
             Some(frame) => *frame,
             None => {
-                let (n, dp_du) = self.normal_and_dp_du(prim);
-                shading_frame(self.shading_normal(prim, n, b0, b1, b2), dp_du)
+                // dp/du as `normal_and_dp_du` computes it.
+                let dp_du = if self.uvs.is_empty() {
+                    p1 - p0
+                } else {
+                    let dp_du = self.face_dp_du[prim as usize];
+                    Vec3A::from(if dp_du == Vec3::ZERO { Frame::from_normal(face_n).s } else { dp_du })
+                };
+                shading_frame_a(self.shading_normal(idx, n.into(), b0, b1, b2), dp_du)
             }
         };
-        SurfaceInteraction { t, p, n, sh_frame, uv, wi: sh_frame.to_local(-ray_d), shape: 0, prim }
+        // `Frame::to_local(-ray_d)`.
+        let v = -Vec3A::from(ray_d);
+        let wi = Vec3::new(v.dot(sh_s), v.dot(sh_t), v.dot(sh_n));
+        let sh_frame = Frame { s: sh_s.into(), t: sh_t.into(), n: sh_n.into() };
+        SurfaceInteraction { t, p: p.into(), n, sh_frame, uv, wi, shape: 0, prim }
     }
 
     /// Uniform by area: pick a triangle by area, then a uniform point on it, `p0 + e0 b1 + e1 b2`
@@ -371,6 +390,96 @@ pub fn from_file_props(
 #[cfg(test)]
 mod tests {
     use crate::shape::Geometry;
+
+    /// The hit record of `Mesh::interaction` (computed in `Vec3A`) is the `Vec3` arithmetic it
+    /// stands for, bit for bit: point, normal, shading frame (Gram–Schmidt of dp/du against the
+    /// interpolated normal, `interaction::shading_frame`) and `wi`, on a smooth mesh (per-hit frames)
+    /// and a flat one (frames stored at load), with and without uvs and `flip_normals`.
+    #[test]
+    fn hit_record_is_the_vec3_arithmetic_bit_for_bit() {
+        use super::{Mesh, MeshData};
+        use crate::math::{Frame, Mat4, Vec2, Vec3};
+        // A 6×6 grid bent into a bump, vertex normals tilted per vertex (or none: flat).
+        let (w, h) = (6u32, 6u32);
+        let mut data = MeshData::default();
+        for j in 0..h {
+            for i in 0..w {
+                let (x, z) = (i as f32 * 0.37 - 0.9, j as f32 * 0.29 - 0.7);
+                data.positions.push(Vec3::new(x, 0.3 * (x * 2.1).sin() * (z * 1.7).cos(), z));
+                data.normals.push(Vec3::new(0.2 * x, 1.0, -0.3 * z * x).normalize());
+                data.uvs.push(Vec2::new(i as f32 * 0.21 + 0.1 * j as f32, j as f32 * 0.17));
+            }
+        }
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let v = j * w + i;
+                data.indices.push([v, v + 1, v + w]);
+                data.indices.push([v + 1, v + w + 1, v + w]);
+            }
+        }
+        data.uvs[7] = data.uvs[8]; // a degenerate uv triangle: dp/du from the face normal
+        let mut sampler = crate::sampler::Sampler::new(7, 0);
+        for (normals, uvs, flip) in
+            [(true, false, false), (true, true, true), (false, false, true), (false, true, false)]
+        {
+            let d = MeshData { uvs: if uvs { data.uvs.clone() } else { Vec::new() }, ..data.clone() };
+            // Without normals: `face_normals` (else the mesh recomputes smooth vertex normals).
+            let mesh = Mesh::new(d, &Mat4::IDENTITY, !normals, flip);
+            assert_eq!(mesh.face_frames.is_empty(), normals);
+            for _ in 0..2000 {
+                let prim = ((sampler.next_1d() * mesh.indices.len() as f32) as u32).min(mesh.indices.len() as u32 - 1);
+                let (mut b1, mut b2) = (sampler.next_1d(), sampler.next_1d());
+                if b1 + b2 > 1.0 {
+                    (b1, b2) = (1.0 - b1, 1.0 - b2);
+                }
+                let dir = Vec3::new(sampler.next_1d() - 0.5, -1.0, sampler.next_1d() - 0.5).normalize();
+                let si = mesh.interaction(prim, b1, b2, 1.5, dir);
+                // The reference, in `Vec3`.
+                let idx = mesh.indices[prim as usize];
+                let [p0, p1, p2] = idx.map(|i| mesh.positions[i as usize]);
+                let b0 = 1.0 - b1 - b2;
+                let p = p0 * b0 + p1 * b1 + p2 * b2;
+                let face_n = mesh.face_normals[prim as usize];
+                let n = if flip { -face_n } else { face_n };
+                let dp_du = match mesh.face_dp_du.get(prim as usize) {
+                    None => p1 - p0,
+                    Some(&dp_du) if dp_du == Vec3::ZERO => Frame::from_normal(face_n).s,
+                    Some(&dp_du) => dp_du,
+                };
+                let sh_n = if mesh.normals.is_empty() {
+                    n
+                } else {
+                    let [n0, n1, n2] = idx.map(|i| mesh.normals[i as usize]);
+                    let v = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
+                    if v == Vec3::ZERO {
+                        n
+                    } else if flip {
+                        -v
+                    } else {
+                        v
+                    }
+                };
+                let s = dp_du - sh_n * sh_n.dot(dp_du);
+                let len2 = s.length_squared();
+                let frame = if len2 > 0.0 && len2.is_finite() {
+                    let s = s / len2.sqrt();
+                    Frame { s, t: sh_n.cross(s), n: sh_n }
+                } else {
+                    Frame::from_normal(sh_n)
+                };
+                let v = -dir;
+                let wi = Vec3::new(v.dot(frame.s), v.dot(frame.t), v.dot(frame.n));
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                let case = format!("normals {normals} uvs {uvs} flip {flip} prim {prim} b ({b1}, {b2})");
+                assert_eq!(bits(si.p), bits(p), "p: {case}");
+                assert_eq!(bits(si.n), bits(n), "n: {case}");
+                assert_eq!(bits(si.sh_frame.s), bits(frame.s), "s: {case}");
+                assert_eq!(bits(si.sh_frame.t), bits(frame.t), "t: {case}");
+                assert_eq!(bits(si.sh_frame.n), bits(frame.n), "sh_n: {case}");
+                assert_eq!(bits(si.wi), bits(wi), "wi: {case}");
+            }
+        }
+    }
 
     #[test]
     fn hit_uv_skipped_only_where_no_texture_reads_it() {
