@@ -298,7 +298,39 @@ impl Bsdf {
         sample1: f32,
         sample2: Vec2,
     ) -> Option<(BsdfSample, Spectrum)> {
-        let (bs, weight) = match self {
+        let (bs, weight) = self.sample_model(ctx, si, sample1, sample2)?;
+        (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
+    }
+
+    /// [`Bsdf::sample`] with the `diffuse` model built into the caller and the other models
+    /// called (the same results): `path`'s loop, where surface scenes are mostly diffuse.
+    #[inline(always)]
+    pub fn sample_inline(
+        &self,
+        ctx: &BsdfContext,
+        si: &SurfaceInteraction,
+        sample1: f32,
+        sample2: Vec2,
+    ) -> Option<(BsdfSample, Spectrum)> {
+        match self {
+            Bsdf::Diffuse(b) => {
+                let (bs, weight) = b.sample(ctx, si, sample1, sample2)?;
+                (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
+            }
+            _ => self.sample(ctx, si, sample1, sample2),
+        }
+    }
+
+    /// The model's own sample, before [`Bsdf::sample`] drops zero-weight results.
+    #[inline(always)]
+    fn sample_model(
+        &self,
+        ctx: &BsdfContext,
+        si: &SurfaceInteraction,
+        sample1: f32,
+        sample2: Vec2,
+    ) -> Option<(BsdfSample, Spectrum)> {
+        match self {
             Bsdf::Diffuse(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::Dielectric(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::ThinDielectric(b) => b.sample(ctx, si, sample1, sample2),
@@ -310,8 +342,7 @@ impl Bsdf {
             Bsdf::Plastic(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::RoughPlastic(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::Mask(b) => b.sample(ctx, si, sample1, sample2),
-        }?;
-        (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
+        }
     }
 
     /// f(wi, wo)·|cos θo| for `wo` in the local frame.
@@ -341,6 +372,16 @@ impl Bsdf {
             Bsdf::Plastic(b) => b.eval_pdf(ctx, si, wo).1,
             Bsdf::RoughPlastic(b) => b.eval_pdf(ctx, si, wo).1,
             Bsdf::Mask(b) => b.eval_pdf(ctx, si, wo).1,
+        }
+    }
+
+    /// [`Bsdf::eval_pdf`] with the `diffuse` model built into the caller and the other models
+    /// called (the same results; see [`Bsdf::sample_inline`]).
+    #[inline(always)]
+    pub fn eval_pdf_inline(&self, ctx: &BsdfContext, si: &SurfaceInteraction, wo: Vec3) -> (Spectrum, f32) {
+        match self {
+            Bsdf::Diffuse(b) => (b.eval(ctx, si, wo), b.pdf(ctx, si, wo)),
+            _ => self.eval_pdf(ctx, si, wo),
         }
     }
 

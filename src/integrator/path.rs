@@ -89,7 +89,7 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
             let (ds, em_weight) = scene.sample_emitter_direction_inline(si.p, Some(si.n), em_sample, false);
             if ds.pdf > 0.0 && em_weight != Spectrum::ZERO {
                 let wo = si.to_local(ds.d);
-                let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf(&ctx, &si, wo);
+                let (bsdf_val, bsdf_pdf) = bsdf.eval_pdf_inline(&ctx, &si, wo);
                 // A zero BSDF value (e.g. the light below a diffuse surface) adds nothing whether
                 // or not the light is visible: the shadow ray is traced for non-zero values only.
                 if bsdf_val != Spectrum::ZERO && scene.emitter_visible_inline(si.p, Some(si.n), &ds) {
@@ -102,7 +102,7 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
         // ---- BSDF sampling ----
         let s1 = sampler.next_1d();
         let s2 = sampler.next_2d();
-        let Some((bs, bsdf_weight)) = bsdf.sample(&ctx, &si, s1, s2) else {
+        let Some((bs, bsdf_weight)) = bsdf.sample_inline(&ctx, &si, s1, s2) else {
             // A failed (zero-weight) sample of a non-null BSDF still makes the path valid (Mitsuba).
             valid |= bsdf_flags & !flags::NULL != 0;
             break;
