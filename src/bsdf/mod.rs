@@ -298,39 +298,7 @@ impl Bsdf {
         sample1: f32,
         sample2: Vec2,
     ) -> Option<(BsdfSample, Spectrum)> {
-        let (bs, weight) = self.sample_model(ctx, si, sample1, sample2)?;
-        (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
-    }
-
-    /// [`Bsdf::sample`] with the `diffuse` model built into the caller and the other models
-    /// called (the same results): `path`'s loop, where surface scenes are mostly diffuse.
-    #[inline(always)]
-    pub fn sample_inline(
-        &self,
-        ctx: &BsdfContext,
-        si: &SurfaceInteraction,
-        sample1: f32,
-        sample2: Vec2,
-    ) -> Option<(BsdfSample, Spectrum)> {
-        match self {
-            Bsdf::Diffuse(b) => {
-                let (bs, weight) = b.sample(ctx, si, sample1, sample2)?;
-                (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
-            }
-            _ => self.sample(ctx, si, sample1, sample2),
-        }
-    }
-
-    /// The model's own sample, before [`Bsdf::sample`] drops zero-weight results.
-    #[inline(always)]
-    fn sample_model(
-        &self,
-        ctx: &BsdfContext,
-        si: &SurfaceInteraction,
-        sample1: f32,
-        sample2: Vec2,
-    ) -> Option<(BsdfSample, Spectrum)> {
-        match self {
+        nonzero(match self {
             Bsdf::Diffuse(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::Dielectric(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::ThinDielectric(b) => b.sample(ctx, si, sample1, sample2),
@@ -342,6 +310,22 @@ impl Bsdf {
             Bsdf::Plastic(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::RoughPlastic(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::Mask(b) => b.sample(ctx, si, sample1, sample2),
+        })
+    }
+
+    /// [`Bsdf::sample`] with the `diffuse` model built into the caller and the other models
+    /// called (the same results): `path`'s loop, where surface scenes are mostly diffuse.
+    #[inline(always)]
+    pub fn sample_inline(
+        &self,
+        ctx: &BsdfContext,
+        si: &SurfaceInteraction,
+        s1: f32,
+        s2: Vec2,
+    ) -> Option<(BsdfSample, Spectrum)> {
+        match self {
+            Bsdf::Diffuse(b) => nonzero(b.sample(ctx, si, s1, s2)),
+            _ => self.sample(ctx, si, s1, s2),
         }
     }
 
@@ -410,6 +394,13 @@ impl Bsdf {
             _ => Spectrum::ZERO,
         }
     }
+}
+
+/// A model's sample as [`Bsdf::sample`] returns it: `None` unless the pdf and the weight are positive.
+#[inline(always)]
+fn nonzero(sample: Option<(BsdfSample, Spectrum)>) -> Option<(BsdfSample, Spectrum)> {
+    let (bs, weight) = sample?;
+    (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
 }
 
 /// An optional reflectance-like texture (`specular_reflectance`, ...): `None` when absent, as
