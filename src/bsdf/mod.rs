@@ -313,8 +313,9 @@ impl Bsdf {
         })
     }
 
-    /// [`Bsdf::sample`] with the `diffuse` model built into the caller and the other models
-    /// called (the same results): `path`'s loop, where surface scenes are mostly diffuse.
+    /// [`Bsdf::sample`] (with `s1`, `s2` its `sample1`, `sample2`) with the `diffuse` model built
+    /// into the caller and the other models called (the same results): `path`'s loop, where
+    /// surface scenes are mostly diffuse.
     #[inline(always)]
     pub fn sample_inline(
         &self,

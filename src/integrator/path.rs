@@ -32,6 +32,7 @@ fn li_avx2(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStat
     li_impl(scene, sampler, ray, stats)
 }
 
+/// The loop of [`li`], built whole into each of its two variants.
 #[inline(always)]
 fn li_impl(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
     let desc = &scene.integrator;
