@@ -44,6 +44,7 @@ impl Diffuse {
         Ok(Diffuse { reflectance })
     }
 
+    #[inline]
     pub fn sample(
         &self,
         ctx: &BsdfContext,
@@ -63,6 +64,7 @@ impl Diffuse {
         Some((bs, self.reflectance.eval(si.uv)))
     }
 
+    #[inline]
     pub fn eval(&self, ctx: &BsdfContext, si: &SurfaceInteraction, wo: Vec3) -> Spectrum {
         if !ctx.is_enabled(flags::DIFFUSE_REFLECTION, 0) || si.wi.z <= 0.0 || wo.z <= 0.0 {
             return Spectrum::ZERO;
@@ -70,6 +72,7 @@ impl Diffuse {
         self.reflectance.eval(si.uv) * (INV_PI * wo.z)
     }
 
+    #[inline]
     pub fn pdf(&self, ctx: &BsdfContext, si: &SurfaceInteraction, wo: Vec3) -> f32 {
         if !ctx.is_enabled(flags::DIFFUSE_REFLECTION, 0) || si.wi.z <= 0.0 || wo.z <= 0.0 {
             return 0.0;

@@ -298,7 +298,7 @@ impl Bsdf {
         sample1: f32,
         sample2: Vec2,
     ) -> Option<(BsdfSample, Spectrum)> {
-        let (bs, weight) = match self {
+        nonzero(match self {
             Bsdf::Diffuse(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::Dielectric(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::ThinDielectric(b) => b.sample(ctx, si, sample1, sample2),
@@ -310,8 +310,24 @@ impl Bsdf {
             Bsdf::Plastic(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::RoughPlastic(b) => b.sample(ctx, si, sample1, sample2),
             Bsdf::Mask(b) => b.sample(ctx, si, sample1, sample2),
-        }?;
-        (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
+        })
+    }
+
+    /// [`Bsdf::sample`] (with `s1`, `s2` its `sample1`, `sample2`) with the `diffuse` model built
+    /// into the caller and the other models called (the same results): `path`'s loop, where
+    /// surface scenes are mostly diffuse.
+    #[inline(always)]
+    pub fn sample_inline(
+        &self,
+        ctx: &BsdfContext,
+        si: &SurfaceInteraction,
+        s1: f32,
+        s2: Vec2,
+    ) -> Option<(BsdfSample, Spectrum)> {
+        match self {
+            Bsdf::Diffuse(b) => nonzero(b.sample(ctx, si, s1, s2)),
+            _ => self.sample(ctx, si, s1, s2),
+        }
     }
 
     /// f(wi, wo)·|cos θo| for `wo` in the local frame.
@@ -344,6 +360,16 @@ impl Bsdf {
         }
     }
 
+    /// [`Bsdf::eval_pdf`] with the `diffuse` model built into the caller and the other models
+    /// called (the same results; see [`Bsdf::sample_inline`]).
+    #[inline(always)]
+    pub fn eval_pdf_inline(&self, ctx: &BsdfContext, si: &SurfaceInteraction, wo: Vec3) -> (Spectrum, f32) {
+        match self {
+            Bsdf::Diffuse(b) => (b.eval(ctx, si, wo), b.pdf(ctx, si, wo)),
+            _ => self.eval_pdf(ctx, si, wo),
+        }
+    }
+
     /// [`eval`](Self::eval) and [`pdf`](Self::pdf) together.
     pub fn eval_pdf(&self, ctx: &BsdfContext, si: &SurfaceInteraction, wo: Vec3) -> (Spectrum, f32) {
         match self {
@@ -369,6 +395,13 @@ impl Bsdf {
             _ => Spectrum::ZERO,
         }
     }
+}
+
+/// A model's sample as [`Bsdf::sample`] returns it: `None` unless the pdf and the weight are positive.
+#[inline(always)]
+fn nonzero(sample: Option<(BsdfSample, Spectrum)>) -> Option<(BsdfSample, Spectrum)> {
+    let (bs, weight) = sample?;
+    (bs.pdf > 0.0 && weight.max_element() > 0.0).then_some((bs, weight))
 }
 
 /// An optional reflectance-like texture (`specular_reflectance`, ...): `None` when absent, as

@@ -618,3 +618,42 @@ fn flags_are_the_union_of_the_lobes() {
         assert_ne!(union, 0, "{plugin}");
     }
 }
+
+/// `Bsdf::sample_inline` / `eval_pdf_inline` (`path`'s loop) give bit for bit what `sample` /
+/// `eval_pdf` give, for the model they build in (diffuse, textured or not) and for the models
+/// they pass on, from above and below the surface.
+#[test]
+fn inline_sampling_and_evaluation_equal_the_called_ones() {
+    let pos = SrcPos::new("test.xml", 1, 1);
+    let checker = ObjectDesc {
+        kind: PluginKind::Texture,
+        plugin: "checkerboard".into(),
+        id: None,
+        props: Props::new(PluginKind::Texture, "checkerboard", pos.clone()),
+        pos,
+    };
+    let bsdfs = [
+        load_bsdf("diffuse", vec![("reflectance", Value::Float(0.7))]),
+        load_bsdf("diffuse", vec![("reflectance", Value::Object(Rc::new(checker)))]),
+        load_bsdf("dielectric", vec![]),
+        load_bsdf("roughplastic", vec![]),
+        load_bsdf("twosided", vec![("a", Value::Object(Rc::new(bsdf_desc("diffuse", vec![]))))]),
+    ];
+    let ctx = BsdfContext::default();
+    let mut s = Sampler::new(5, 0);
+    for (b, bsdf) in bsdfs.iter().enumerate() {
+        for k in 0..2000 {
+            let wi = sph(if k % 4 == 0 { 120.0 } else { 180.0 * s.next_1d() * 0.5 }, 360.0 * s.next_1d());
+            let mut si = si_with_wi(wi);
+            si.uv = s.next_2d() * 4.0;
+            let (s1, s2) = (s.next_1d(), s.next_2d());
+            let called = bsdf.sample(&ctx, &si, s1, s2).map(|(bs, w)| (bs.wo, bs.pdf, bs.eta, bs.sampled_type, w));
+            let inline =
+                bsdf.sample_inline(&ctx, &si, s1, s2).map(|(bs, w)| (bs.wo, bs.pdf, bs.eta, bs.sampled_type, w));
+            assert_eq!(format!("{called:?}"), format!("{inline:?}"), "bsdf {b}, sample {k}");
+            let wo = sph(180.0 * s.next_1d(), 360.0 * s.next_1d());
+            let (called, inline) = (bsdf.eval_pdf(&ctx, &si, wo), bsdf.eval_pdf_inline(&ctx, &si, wo));
+            assert_eq!(format!("{called:?}"), format!("{inline:?}"), "bsdf {b}, eval {k}");
+        }
+    }
+}
