@@ -116,10 +116,10 @@ impl SplitTables {
 }
 
 /// The splitting tables of `scene` under `opts` (with `connection = complete`), `None` where it
-/// does not run: `split_glints` off, `transport = snee` (it keeps no surface paths), or no emitter
-/// that a ray can hit.
+/// does not run: `split_glints` off, `transport = snee` (it keeps no surface paths), no smooth
+/// `dielectric`, or no emitter that a ray can hit.
 pub fn tables(scene: &Scene, opts: SneeOptions) -> Option<SplitTables> {
-    if !opts.split_glints || !opts.keeps_all() {
+    if !opts.split_glints || !opts.keeps_all() || !scene.bsdfs.iter().any(|b| matches!(b, Bsdf::Dielectric(_))) {
         return None;
     }
     let lights: Vec<LightBound> = scene
