@@ -205,6 +205,11 @@ fn forward_only(scene: &Scene) -> bool {
     matches!(&scene.integrator, Integrator::VolpathSnee(_, s) if s.forward_only)
 }
 
+/// Does emitter splitting at smooth dielectric vertices run (`manifold/split.rs`)?
+fn split_glints(scene: &Scene) -> bool {
+    matches!(&scene.integrator, Integrator::VolpathSnee(_, s) if s.split.is_some() && !s.forward_only)
+}
+
 pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
     let film = &scene.film;
     let sampler = &scene.sampler;
@@ -247,6 +252,7 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         integ_json["connection"] = json!(integ.connection.name());
         integ_json["reflection_chains"] = json!(integ.snee.chains);
         integ_json["forward_only"] = json!(forward_only(scene));
+        integ_json["split_glints"] = json!(split_glints(scene));
     }
     let json = json!({
         "plugins": tree_json(&parsed.root, None),
@@ -305,6 +311,8 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         let _ = write!(text, ", connection = {}", integ.connection.name());
         if forward_only(scene) {
             let _ = write!(text, " (nothing of it applies here: renders with volpath's loop)");
+        } else if split_glints(scene) {
+            let _ = write!(text, ", emitter splitting at smooth dielectric vertices");
         }
     }
     let _ = writeln!(text, "{}", if integ.moment { " (inside moment: also m2.R, m2.G, m2.B)" } else { "" });

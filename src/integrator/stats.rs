@@ -85,4 +85,9 @@ counters! {
     glint_iterations,
     glint_solutions,
     glint_trials_capped,
+    /// Emitter splitting at smooth dielectric vertices (`manifold/split.rs`): lobes that BSDF
+    /// sampling did not pick and that were split (the emitter's bounds tested), and of them the
+    /// rays cast (also counted in `rays`).
+    split_lobes,
+    split_rays,
 }

@@ -24,6 +24,7 @@
 use super::classes::{End, NoClasses, Tally};
 use super::cx::ForwardWeight;
 pub use super::cx::{Cx, EmitterHit, Scatter, Stages};
+use super::manifold::split::GlintSplit;
 use super::manifold::ManifoldStage;
 use super::snee::{ForwardTechnique, LightSample, Snee, SneeStage};
 use super::stats::LocalStats;
@@ -520,6 +521,8 @@ fn trace_from<W: PathWeight, T: Tally, const TRACED: bool>(
     let keep_all = snee.as_ref().is_none_or(|s| s.keeps_all());
     // Manifold NEE through flat boundaries (volpath_snee with connection = complete).
     let mut manifold = snee.as_ref().and_then(|s| ManifoldStage::new(scene, s.tables()));
+    // Emitter splitting at smooth dielectric vertices (connection = complete, manifold/split.rs).
+    let mut split = manifold.as_ref().and_then(|_| GlintSplit::new(snee.as_ref()?.tables()));
 
     loop {
         // ---- Russian roulette and depth limit ----
@@ -548,6 +551,9 @@ fn trace_from<W: PathWeight, T: Tally, const TRACED: bool>(
                 valid_ray = true;
                 specular_chain = !m.sample_emitters;
                 tally.medium_vertex(p, mi);
+                if let Some(split) = &mut split {
+                    split.at_scatter();
+                }
 
                 // ---- Emitter sampling at the medium vertex ----
                 let c = weight.medium_emitter_sampling(
@@ -630,7 +636,10 @@ fn trace_from<W: PathWeight, T: Tally, const TRACED: bool>(
         let connection = snee.as_ref().map(|snee| ConnectionStages { snee, manifold: manifold.as_ref() });
         let stages = Stages { forward: connection.as_ref().map(|c| c as &dyn ForwardWeight) };
         if let (false, Some(hit)) = (hide, hit) {
-            let c = weight.emitter_hit(&mut Cx { scene, channel, medium, sampler, stats, stages }, &hit);
+            let mut c = weight.emitter_hit(&mut Cx { scene, channel, medium, sampler, stats, stages }, &hit);
+            if let Some(split) = &mut split {
+                c *= split.take_hit_scale();
+            }
             result += c;
             tally.add(scene, c, End::Hit);
         }
@@ -655,6 +664,14 @@ fn trace_from<W: PathWeight, T: Tally, const TRACED: bool>(
         };
         eta *= bs.eta;
         let wo = s.to_world(bs.wo);
+        if let Some(split) = &mut split {
+            let beta = weight.beta();
+            if let Some((c, d)) = split.at_bsdf_sample(scene, &s, bsdf, &bs, wo, medium, beta, depth, max_depth, stats)
+            {
+                result += c;
+                tally.add(scene, c, End::SurfaceNee { s: &s, d: ray.d, light_d: d });
+            }
+        }
         let non_null = bs.sampled_type & flags::NULL == 0;
         if non_null {
             tally.surface_vertex(&s, ray.d, bs.sampled_type & flags::TRANSMISSION != 0);

@@ -24,3 +24,4 @@ mod meter_glint;
 mod snee_degenerate;
 mod snee_slab;
 mod snee_unbiased;
+mod split_glints;

@@ -50,6 +50,7 @@ pub mod rough;
 pub mod rough_finite;
 pub mod rough_lobe;
 pub mod rough_rate;
+pub mod split;
 pub mod stage;
 pub mod track;
 

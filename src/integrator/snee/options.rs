@@ -30,6 +30,9 @@ pub struct SneeOptions {
     /// area-light connection (`manifold/curved_finite.rs`) runs at a medium vertex whose emitter
     /// sample picked an area light; `None`: `manifold::curved_finite::RATE`.
     pub connection_rate: Option<f32>,
+    /// `split_glints` (with `connection = complete`): emitter splitting at smooth dielectric
+    /// vertices (`manifold/split.rs`).
+    pub split_glints: bool,
 }
 
 impl Default for SneeOptions {
@@ -40,6 +43,7 @@ impl Default for SneeOptions {
             rate: None,
             chains: false,
             connection_rate: None,
+            split_glints: true,
         }
     }
 }
@@ -86,6 +90,9 @@ pub struct Snee {
     /// With `connection = complete`: the irradiance meter's direction mixture towards the glints
     /// of directional lights on the rough boundary it faces (`manifold::meter_glint`).
     pub meter_glint: Option<crate::integrator::manifold::meter_glint::MeterGlint>,
+    /// With `connection = complete` and `split_glints`: what emitter splitting at smooth
+    /// dielectric vertices needs of the scene (`manifold::split`); `None` where it does not run.
+    pub split: Option<crate::integrator::manifold::split::SplitTables>,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).

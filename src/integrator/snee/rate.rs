@@ -22,6 +22,7 @@ pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
         forward_only: false,
         has_directional: false,
         meter_glint: None,
+        split: None,
     }
 }
 
