@@ -214,8 +214,13 @@ impl<'a> GlintSplit<'a> {
         max_depth: u32,
         stats: &mut LocalStats,
     ) -> Option<(Spectrum, Vec3)> {
-        let after_medium_vertex = std::mem::replace(&mut self.after_medium_vertex, false);
         self.hit_scale = 1.0;
+        // A null crossing is not a surface event: the next real one may still be the `x_k` of the
+        // last medium vertex (SNEE and the connections carry their suffix across passable surfaces).
+        if bs.sampled_type & flags::NULL != 0 {
+            return None;
+        }
+        let after_medium_vertex = std::mem::replace(&mut self.after_medium_vertex, false);
         if bs.sampled_type & flags::DELTA == 0 || !matches!(bsdf, Bsdf::Dielectric(_)) || depth + 1 >= max_depth {
             return None;
         }
