@@ -16,6 +16,7 @@
 use super::curved_finite;
 use super::rough::RoughPending;
 use super::track::{Pending, Tracker};
+use super::MediumVertex;
 use super::{forward_weight, Connection};
 use crate::bsdf::BsdfSample;
 use crate::color::Spectrum;
@@ -176,7 +177,24 @@ impl<'a> ManifoldStage<'a> {
     /// (The pending records are empty here: [`Self::at_surface`] moved them to the arrived ones.)
     #[inline]
     pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
+        debug_assert!(self.rough_pending.is_none() && self.curved_pending.is_none() && self.tracker.pending.is_none());
         let x_j = self.tracker.x_j.take();
+        // Nothing to start (no `x_j`) nor to carry: every crossing leaves the records empty.
+        if x_j.is_none() && self.arrived.is_none() && self.rough_arrived.is_none() && self.curved_arrived.is_none() {
+            return;
+        }
+        self.records_after_bsdf(scene, s, bs, wo, x_j);
+    }
+
+    /// [`Self::after_bsdf`] where `x_j` (taken) or a record that arrived is there.
+    fn records_after_bsdf(
+        &mut self,
+        scene: &Scene,
+        s: &SurfaceInteraction,
+        bs: &BsdfSample,
+        wo: Vec3,
+        x_j: Option<MediumVertex>,
+    ) {
         let records = self.records;
         match Crossing::of(scene, s, bs, wo) {
             Crossing::Out => {

@@ -130,8 +130,13 @@ impl<'a> SneeStage<'a> {
 
     /// BSDF sampling at `s` chose `bs` towards `wo`: a refraction out of `x_k` carries its suffix
     /// on, and so does a null crossing of a passable surface (docs/snee.md §1).
+    /// (`pending` is empty here: [`Self::at_surface`] moved it to `arrived`.)
     #[inline]
     pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
+        debug_assert!(self.pending.is_none());
+        if self.at_k.is_none() && self.arrived.is_none() {
+            return;
+        }
         match Crossing::of(scene, s, bs, wo) {
             Crossing::Out => copy_some(&mut self.pending, &self.at_k),
             Crossing::Passed => copy_some(&mut self.pending, &self.arrived),
