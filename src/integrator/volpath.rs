@@ -230,22 +230,6 @@ pub fn li(
     medium: Option<u32>,
     stats: &mut LocalStats,
 ) -> (Spectrum, bool) {
-    // A camera ray outside media that finds no surface, in a scene without an environment, ends
-    // the path in the loop's first iteration with nothing added and `valid_ray` false, after the
-    // hero channel's and the first roulette's samples (the roulette of `beta = 1` at depth 0
-    // passes). Those two samples are drawn here without entering the loop; a surface the ray
-    // finds is handed to the loop, which then does not trace it again. Same samples, same result.
-    if medium.is_none() && scene.environment.is_none() && scene.integrator.max_depth != 0 {
-        stats.rays += 1;
-        let si = scene.ray_intersect(&ray);
-        if si.is_none() {
-            let _ = sampler.next_1d();
-            let _ = sampler.next_1d();
-            return (Spectrum::ZERO, false);
-        }
-        let weight = Beta { beta: Spectrum::ONE, last_scatter_pdf: 1.0 };
-        return trace_from::<_, _, true>(scene, sampler, ray, medium, stats, weight, None, &mut NoClasses, si);
-    }
     li_with(scene, sampler, ray, medium, stats, None)
 }
 
@@ -258,6 +242,24 @@ pub fn li_with(
     stats: &mut LocalStats,
     snee: Option<&Snee>,
 ) -> (Spectrum, bool) {
+    // A camera ray outside media that finds no surface, in a scene without an environment, ends
+    // the path in the loop's first iteration with nothing added and `valid_ray` false, after the
+    // hero channel's and the first roulette's samples (the roulette of `beta = 1` at depth 0
+    // passes; the stages of `snee` see an escape and do nothing). Those two samples are drawn here
+    // without entering the loop; a surface the ray finds is handed to the loop, which then does
+    // not trace it again. Same samples, same result.
+    if medium.is_none() && scene.environment.is_none() && scene.integrator.max_depth != 0 {
+        stats.rays += 1;
+        let si = scene.ray_intersect(&ray);
+        if si.is_none() {
+            let _ = sampler.next_1d();
+            let _ = sampler.next_1d();
+            return (Spectrum::ZERO, false);
+        }
+        let weight = Beta { beta: Spectrum::ONE, last_scatter_pdf: 1.0 };
+        let stage = snee.map(SneeStage::new);
+        return trace_from::<_, _, true>(scene, sampler, ray, medium, stats, weight, stage, &mut NoClasses, si);
+    }
     li_tally(scene, sampler, ray, medium, stats, snee, &mut NoClasses)
 }
 

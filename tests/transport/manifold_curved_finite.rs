@@ -55,6 +55,39 @@ fn sphere_light_through_glass_blob_agrees_with_volpath() {
     glass_agrees_with_volpath("blob.ply", 60_000);
 }
 
+/// `complete` at its DEFAULT rates (neither `snee_rate` nor `connection_rate` given) through the
+/// glass pebble, a thin medium (σt 2, optical size τ = 2.48): SNEE does not run there
+/// (`snee::rate::complete_rates`), and the curved area-light connection's top rate is
+/// `curved_finite::default_top_rate`'s `(1/256) / m(τ)` = 0.0106, a fifth of `RATE`, set when the
+/// integrator is built; the connection and forward tracing (whose MIS density re-solves at that
+/// built rate) must agree with `volpath`. Sample counts fixed before the first run: 12 × 1024 spp
+/// for `volpath` (as the glass tests above), 12 × 256 for `complete`; 15 s on the loaded machine.
+/// Measured: image means 0.00824 / 0.00870 (red), relative standard errors 2.4 % / 2.1 %, no test
+/// failed. Shown to fail: with the forward side's density taken at `RATE` instead of the built
+/// rate (`curved_finite::density`'s `q` times `RATE / rate(opts)`), `complete` read 0.00583, 29 %
+/// darker, t = 10.2 on the image mean and failures in two blocks.
+#[test]
+fn default_rates_in_a_thin_medium_agree_with_volpath() {
+    use snee::integrator::manifold::{curved_finite::RATE, tables};
+    let complete =
+        scene(&mesh("volpath_snee", r#"<string name="connection" value="complete"/>"#, GLASS, "pebble.ply"), &[]);
+    let q = complete.integrator.snee.connection_rate.expect("a thin medium: a default top rate below RATE");
+    let snee = tables(&complete).expect("volpath_snee");
+    let tau = snee::integrator::snee::rate::optical_size(&complete, 0);
+    eprintln!("optical size {tau}, default top rate {q}");
+    assert!((q as f64) < RATE / 4.0, "top rate {q}");
+    assert!(snee.rates.iter().all(|r| r.is_none_or(|r| r == 0.0)), "SNEE runs: {:?}", snee.rates);
+    // The connection and the forward side's re-solves both run (a 64-spp render's counters).
+    let opts = snee::render::RenderOptions { spp: Some(64), seed: 1, time_budget: None, progress: false };
+    let stats = snee::render::render(&complete, &opts, &std::sync::atomic::AtomicBool::new(false)).stats;
+    assert!(stats.manifold_solutions > 0 && stats.manifold_resolve_matches > 0, "{stats:?}");
+    let volpath = render_batches(&scene(&mesh("volpath", "", GLASS, "pebble.ply"), &[]), 12, 1024, 8, 90_000);
+    let batches = render_batches(&complete, 12, 256, 8, 90_100);
+    assert_eq!(batches.rejected, 0);
+    let report = common::agree_with_reference(("volpath", &volpath), &[("complete, default rates", &batches)], 0.01);
+    assert!(report.is_empty(), "{report}");
+}
+
 #[test]
 fn sphere_light_through_matched_pebble_agrees_with_null_boundary() {
     let volpath =

@@ -26,10 +26,9 @@ use super::mis::{self, EnvPdfs, EnvTechnique};
 use super::newton_point::{self, PointSolution};
 use super::{add_finite, MediumVertex};
 use crate::bsdf::fresnel::fresnel;
-use crate::bsdf::{flags, BsdfSample};
 use crate::color::Spectrum;
 use crate::integrator::snee::light::light_transmission;
-use crate::integrator::snee::{passable, LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
+use crate::integrator::snee::{LightSample, SneeOptions, SneeSuffix, SneeTechnique, SneeVertex};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::SurfaceInteraction;
 use crate::math::{DVec3, Ray, Vec3};
@@ -355,33 +354,17 @@ pub struct Pending {
     pub omega_jk: Vec3,
 }
 
-/// After BSDF sampling at `s` (`bs` towards `wo`): a refraction out of `x_j`'s curved boundary
-/// right after `x_j` starts a [`Pending`]; a null crossing of a passable surface carries
-/// `carried`; anything else forgets it.
-pub fn pending(
-    scene: &Scene,
-    x_i: Option<SneeVertex>,
-    x_j: Option<MediumVertex>,
-    s: &SurfaceInteraction,
-    bs: &BsdfSample,
-    wo: Vec3,
-    carried: Option<Pending>,
-) -> Option<Pending> {
-    let non_null = bs.sampled_type & flags::NULL == 0;
-    if non_null && bs.sampled_type & flags::TRANSMISSION != 0 && wo.dot(s.n) > 0.0 {
-        let x_j = x_j?;
-        if !super::locate::applies(scene, x_j.medium) {
-            return None;
-        }
-        let omega_jk = s.p - x_j.p;
-        let omega_jk = omega_jk / omega_jk.length();
-        boundary_patch(scene, s, x_j.medium, omega_jk)?;
-        Some(Pending { x_i, x_j, si_k: *s, omega_jk })
-    } else if !non_null && passable(scene, s) {
-        carried
-    } else {
-        None
+/// The record of a refraction out at `s` right after the medium vertex `x_j` (the ray leaving
+/// `x_j`'s curved boundary there; `None` where the curved connection does not apply or no patch of
+/// the boundary holds `s`).
+pub fn pending(scene: &Scene, x_i: Option<SneeVertex>, x_j: MediumVertex, s: &SurfaceInteraction) -> Option<Pending> {
+    if !super::locate::applies(scene, x_j.medium) {
+        return None;
     }
+    let omega_jk = s.p - x_j.p;
+    let omega_jk = omega_jk / omega_jk.length();
+    boundary_patch(scene, s, x_j.medium, omega_jk)?;
+    Some(Pending { x_i, x_j, si_k: *s, omega_jk })
 }
 
 /// The weight of a forward path `p` that hit the area light at `y` (along `omega_l`): the

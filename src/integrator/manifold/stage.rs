@@ -5,10 +5,10 @@
 //! | loop event                   | call                          | what the manifold connection does                |
 //! |------------------------------|-------------------------------|--------------------------------------------------|
 //! | real scatter `p` in a medium | [`ManifoldStage::at_scatter`] | `x_j = p`; one connection through the flat boundary, MIS-weighted against SNEE run at the previous vertex `x_i` (`manifold::sample`) |
-//! | the ray reaches a surface    | [`ManifoldStage::at_surface`] | takes the pending suffix `x_j → x_k → …` the ray carries ([`Tracker::surface_event`]) |
+//! | the ray reaches a surface    | [`ManifoldStage::at_surface`] | takes the pending suffixes `x_j → x_k → …` the ray carries |
 //! | an emitter is hit            | [`ManifoldStage::weight`]     | the MIS weight of an escape right after leaving `x_j`'s medium (`manifold::forward_weight`) |
 //! | emitter sampling at `x_k`    | [`ManifoldStage::nee_weight`] | the MIS weight of forward NEE at a rough `x_k` right after `x_j` (`rough::nee_weight`) |
-//! | BSDF sampling at a surface   | [`ManifoldStage::after_bsdf`] | starts or carries the pending suffix ([`Tracker::after_bsdf`]) |
+//! | BSDF sampling at a surface   | [`ManifoldStage::after_bsdf`] | starts, carries or ends the pending suffixes (`snee::stage::Crossing`) |
 //!
 //! SNEE's side of the MIS (a SNEE sample the connection could also have made) is one call in
 //! `snee/sample.rs` (`manifold::snee_weight`).
@@ -16,24 +16,55 @@
 use super::curved_finite;
 use super::rough::RoughPending;
 use super::track::{Pending, Tracker};
+use super::MediumVertex;
 use super::{forward_weight, Connection};
-use crate::bsdf::{flags, BsdfSample};
+use crate::bsdf::BsdfSample;
 use crate::color::Spectrum;
 use crate::integrator::cx::Cx;
 use crate::integrator::cx::Scatter;
-use crate::integrator::snee::passable;
-use crate::integrator::snee::stage::{shift, take_some};
+use crate::integrator::snee::stage::{clear, shift, Crossing};
 use crate::integrator::snee::{Snee, SneeStage, SneeVertex};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::DirectionSample;
 use crate::interaction::SurfaceInteraction;
 use crate::math::Vec3;
-use crate::scene::world::Scene;
+use crate::scene::world::{Scene, SceneEmitter};
+
+/// Which of the stage's pending records can ever start in a scene, decided once at scene load
+/// (`volpath_snee::build`, kept in `Snee::records`): a record no connection of the scene can start
+/// is never written, moved or looked up along a path. A record that could start but has no use is
+/// left out too: the curved one is read only at an area light's hit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Records {
+    /// Through a flat plane of a smooth boundary ([`Pending`], `track.rs`): some medium has a flat
+    /// boundary (`Snee::flat`).
+    pub flat: bool,
+    /// Through a flat or curved rough boundary ([`RoughPending`], `rough.rs`): some medium has one
+    /// (`Snee::rough`).
+    pub rough: bool,
+    /// Through a curved smooth boundary (`curved_finite::Pending`): some medium has one where the
+    /// curved connection applies (`Snee::curved`), and the scene has an area light.
+    pub curved: bool,
+}
+
+impl Records {
+    /// The records `snee`'s manifold tables (built for `scene`) can start.
+    pub fn of(scene: &Scene, snee: &Snee) -> Records {
+        let area_light = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Area { .. }));
+        Records {
+            flat: snee.flat.iter().any(Option::is_some),
+            rough: snee.rough.iter().any(Option::is_some),
+            curved: area_light && snee.curved.iter().any(|&c| c),
+        }
+    }
+}
 
 /// The manifold connection's state along one path.
 #[derive(Clone, Debug)]
 pub struct ManifoldStage<'a> {
     snee: &'a Snee,
+    /// The records kept in this scene (`Snee::records`).
+    records: Records,
     /// The last medium vertex `x_j` and the suffix the ray leaving the last surface carries.
     tracker: Tracker,
     /// The pending suffix as it was when the ray reached the current surface (or escaped).
@@ -56,6 +87,7 @@ impl<'a> ManifoldStage<'a> {
     pub fn new(scene: &Scene, snee: &'a Snee) -> Option<Self> {
         (scene.integrator.connection == Connection::Complete).then(|| ManifoldStage {
             snee,
+            records: snee.records,
             tracker: Tracker::default(),
             arrived: None,
             hit: None,
@@ -100,7 +132,7 @@ impl<'a> ManifoldStage<'a> {
     /// The ray reached a surface (`None`: it escaped).
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
-        self.arrived = self.tracker.surface_event();
+        shift(&mut self.arrived, &mut self.tracker.pending);
         shift(&mut self.rough_arrived, &mut self.rough_pending);
         shift(&mut self.curved_arrived, &mut self.curved_pending);
         // `hit` is read only with a record that arrived or after a medium vertex `x_j` (`weight`,
@@ -109,7 +141,11 @@ impl<'a> ManifoldStage<'a> {
             || self.rough_arrived.is_some()
             || self.curved_arrived.is_some()
             || self.tracker.x_j.is_some();
-        self.hit = if read { si.copied() } else { None };
+        if read {
+            self.hit = si.copied();
+        } else {
+            clear(&mut self.hit);
+        }
     }
 
     /// The weight of an emitter hit along `d` by forward tracing, when the manifold connection
@@ -135,19 +171,66 @@ impl<'a> ManifoldStage<'a> {
         forward_weight(scene, opts, self.arrived.as_ref(), snee.arrived(), self.hit.as_ref(), d, channel, stats)
     }
 
-    /// BSDF sampling at `s` chose `bs` towards `wo`.
+    /// BSDF sampling at `s` chose `bs` towards `wo`: a refraction out right after the medium vertex
+    /// `x_j` starts the records of the boundary it left through, a null crossing of a passable
+    /// surface carries the records the ray arrived with, anything else ends them. Always ends `x_j`.
+    /// (The pending records are empty here: [`Self::at_surface`] moved them to the arrived ones.)
     #[inline]
     pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
-        let non_null = bs.sampled_type & flags::NULL == 0;
-        self.rough_pending = if non_null && bs.sampled_type & flags::TRANSMISSION != 0 && wo.dot(s.n) > 0.0 {
-            self.tracker.x_j.and_then(|x_j| super::rough::pending(scene, self.x_i, x_j, s))
-        } else if !non_null && passable(scene, s) {
-            self.rough_arrived.take()
-        } else {
-            None
-        };
-        self.curved_pending =
-            curved_finite::pending(scene, self.x_i, self.tracker.x_j, s, bs, wo, take_some(&mut self.curved_arrived));
-        self.tracker.after_bsdf(scene, s, bs.sampled_type, wo, take_some(&mut self.arrived));
+        debug_assert!(self.rough_pending.is_none() && self.curved_pending.is_none() && self.tracker.pending.is_none());
+        let x_j = self.tracker.x_j.take();
+        // Nothing to start (no `x_j`) nor to carry: every crossing leaves the records empty.
+        if x_j.is_none() && self.arrived.is_none() && self.rough_arrived.is_none() && self.curved_arrived.is_none() {
+            return;
+        }
+        self.records_after_bsdf(scene, s, bs, wo, x_j);
+    }
+
+    /// [`Self::after_bsdf`] where `x_j` (taken) or a record that arrived is there.
+    fn records_after_bsdf(
+        &mut self,
+        scene: &Scene,
+        s: &SurfaceInteraction,
+        bs: &BsdfSample,
+        wo: Vec3,
+        x_j: Option<MediumVertex>,
+    ) {
+        let records = self.records;
+        match Crossing::of(scene, s, bs, wo) {
+            Crossing::Out => {
+                let Some(x_j) = x_j else { return self.end_pending() };
+                if records.rough {
+                    set(&mut self.rough_pending, super::rough::pending(scene, self.x_i, x_j, s));
+                }
+                if records.curved {
+                    set(&mut self.curved_pending, curved_finite::pending(scene, self.x_i, x_j, s));
+                }
+                if records.flat {
+                    set(&mut self.tracker.pending, Pending::start(scene, x_j, s));
+                }
+            }
+            Crossing::Passed => {
+                shift(&mut self.rough_pending, &mut self.rough_arrived);
+                shift(&mut self.curved_pending, &mut self.curved_arrived);
+                shift(&mut self.tracker.pending, &mut self.arrived);
+            }
+            Crossing::Ends => self.end_pending(),
+        }
+    }
+
+    /// Empty the pending records (no forward path the connections share goes on).
+    #[inline]
+    fn end_pending(&mut self) {
+        clear(&mut self.rough_pending);
+        clear(&mut self.curved_pending);
+        clear(&mut self.tracker.pending);
+    }
+}
+
+/// `*o = v`, writing nothing when both are `None`.
+#[inline(always)]
+fn set<T>(o: &mut Option<T>, v: Option<T>) {
+    if v.is_some() || o.is_some() {
+        *o = v;
     }
 }

@@ -80,6 +80,9 @@ pub struct Snee {
     pub rough: Vec<Option<crate::integrator::manifold::planes::RoughBoundary>>,
     /// Per medium: does the curved connection apply (`manifold::curved::curved_boundaries`)?
     pub curved: Vec<bool>,
+    /// Which pending records the manifold stage keeps in this scene (from the three tables above;
+    /// all `false` with `paper`).
+    pub records: crate::integrator::manifold::stage::Records,
     /// Nothing of `volpath_snee` runs in this scene (no SNEE rate above 0, no manifold connection
     /// or glint that serves its emitters, all transport kept): `li` is then volpath's loop, whose
     /// estimate `volpath_snee`'s would equal (`volpath_snee::forward_only`, docs/snee.md §5).

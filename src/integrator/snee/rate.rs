@@ -19,6 +19,7 @@ pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
         flat: Vec::new(),
         rough: Vec::new(),
         curved: Vec::new(),
+        records: Default::default(),
         forward_only: false,
         has_directional: false,
         meter_glint: None,

@@ -87,10 +87,12 @@ impl<'a> SneeStage<'a> {
     #[inline]
     pub fn at_surface(&mut self, scene: &Scene, si: Option<&SurfaceInteraction>, d: Vec3) {
         self.x_i = None;
-        self.at_k = match (self.chain.take(), si) {
-            (Some((x_i, x_j)), Some(s)) if encloses(scene, s, x_i.medium, d) => Some(SneeSuffix { x_i, x_j, si_k: *s }),
-            _ => None,
-        };
+        match (take_some(&mut self.chain), si) {
+            (Some((x_i, x_j)), Some(s)) if encloses(scene, s, x_i.medium, d) => {
+                self.at_k = Some(SneeSuffix { x_i, x_j, si_k: *s })
+            }
+            _ => clear(&mut self.at_k),
+        }
         shift(&mut self.arrived, &mut self.pending);
     }
 
@@ -128,13 +130,44 @@ impl<'a> SneeStage<'a> {
 
     /// BSDF sampling at `s` chose `bs` towards `wo`: a refraction out of `x_k` carries its suffix
     /// on, and so does a null crossing of a passable surface (docs/snee.md §1).
+    /// (`pending` is empty here: [`Self::at_surface`] moved it to `arrived`.)
     #[inline]
     pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
+        debug_assert!(self.pending.is_none());
+        if self.at_k.is_none() && self.arrived.is_none() {
+            return;
+        }
+        match Crossing::of(scene, s, bs, wo) {
+            Crossing::Out => copy_some(&mut self.pending, &self.at_k),
+            Crossing::Passed => copy_some(&mut self.pending, &self.arrived),
+            Crossing::Ends => {}
+        }
+    }
+}
+
+/// What BSDF sampling at a surface did, as a record of a suffix that the path carries sees it
+/// (SNEE's and the manifold connections' pending records; docs/snee.md §1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Crossing {
+    /// A refraction out through the surface (`wo` on the side of its normal): a record may start.
+    Out,
+    /// A null crossing of a passable surface: the record the ray arrived with goes on.
+    Passed,
+    /// Anything else: the record ends.
+    Ends,
+}
+
+impl Crossing {
+    /// The crossing at `s` where BSDF sampling chose `bs` towards `wo`.
+    #[inline]
+    pub fn of(scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) -> Crossing {
         let non_null = bs.sampled_type & flags::NULL == 0;
-        if bs.sampled_type & flags::TRANSMISSION != 0 && non_null && wo.dot(s.n) > 0.0 {
-            self.pending = self.at_k;
+        if non_null && bs.sampled_type & flags::TRANSMISSION != 0 && wo.dot(s.n) > 0.0 {
+            Crossing::Out
         } else if !non_null && passable(scene, s) {
-            self.pending = self.arrived;
+            Crossing::Passed
+        } else {
+            Crossing::Ends
         }
     }
 }
@@ -146,6 +179,22 @@ impl<'a> SneeStage<'a> {
 pub fn shift<T>(arrived: &mut Option<T>, pending: &mut Option<T>) {
     if pending.is_some() || arrived.is_some() {
         *arrived = pending.take();
+    }
+}
+
+/// `*dst = *src`, writing nothing when both are `None` (for the same records as [`shift`]).
+#[inline(always)]
+pub fn copy_some<T: Copy>(dst: &mut Option<T>, src: &Option<T>) {
+    if src.is_some() || dst.is_some() {
+        *dst = *src;
+    }
+}
+
+/// `*o = None`, writing nothing when `o` is `None` already (for the same records as [`shift`]).
+#[inline(always)]
+pub fn clear<T>(o: &mut Option<T>) {
+    if o.is_some() {
+        *o = None;
     }
 }
 
