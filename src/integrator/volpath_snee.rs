@@ -121,7 +121,7 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         snee.flat = manifold::flat::flat_boundaries(scene);
         snee.rough = manifold::rough::rough_boundaries(scene);
         snee.curved = manifold::curved::curved_boundaries(scene, &snee.flat);
-        snee.records = manifold::stage::Records::of(scene, &snee);
+        snee.records = manifold::stage::records(scene, &snee);
         snee::rate::complete_rates(scene, &mut snee);
         // Only a top rate below `RATE` is stored: elsewhere `RATE` itself stands, bit for bit.
         if snee.options.connection_rate.is_none() {

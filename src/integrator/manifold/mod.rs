@@ -51,6 +51,7 @@ pub mod rough_finite;
 pub mod rough_lobe;
 pub mod rough_rate;
 pub mod split;
+pub mod split_bounds;
 pub mod stage;
 pub mod track;
 

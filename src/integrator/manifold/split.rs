@@ -53,67 +53,17 @@
 use crate::bsdf::fresnel::reflect_local;
 use crate::bsdf::{flags, Bsdf, BsdfContext, BsdfSample};
 use crate::color::Spectrum;
+use crate::integrator::manifold::split_bounds::{LightBound, SplitTables};
 use crate::integrator::snee::options::{Snee, SneeOptions};
 use crate::integrator::stats::LocalStats;
 use crate::integrator::walk::{is_medium_transition, target_medium};
 use crate::interaction::SurfaceInteraction;
-use crate::math::{Aabb, Ray, Vec2, Vec3};
+use crate::math::{Aabb, Vec2, Vec3};
 use crate::scene::world::{Scene, SceneEmitter};
 use crate::shape::Geometry;
 
 /// Relative padding of an emitter's bound, so that rounding never skips a ray the BVH would hit.
 const PAD: f32 = 1e-3;
-
-/// The bound of one area emitter's shape.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum LightBound {
-    /// A sphere: centre and squared (padded) radius.
-    Sphere { center: Vec3, radius2: f32 },
-    /// Any other shape: its (padded) axis-aligned box.
-    Box(Aabb),
-}
-
-impl LightBound {
-    /// Can `ray` (from `o` along unit `d`, `t > 0`) meet the bounded shape?
-    #[inline]
-    fn meets(&self, ray: &Ray) -> bool {
-        match *self {
-            LightBound::Sphere { center, radius2 } => {
-                let oc = center - ray.o;
-                let t_mid = oc.dot(ray.d);
-                let miss2 = oc.length_squared() - t_mid * t_mid;
-                // The far intersection lies ahead: `t_mid + sqrt(r² − miss²) > 0`.
-                miss2 <= radius2 && (t_mid >= 0.0 || t_mid * t_mid <= radius2 - miss2)
-            }
-            LightBound::Box(b) => {
-                let inv = ray.d.recip();
-                let t0 = (b.min - ray.o) * inv;
-                let t1 = (b.max - ray.o) * inv;
-                let near = t0.min(t1).max_element().max(0.0);
-                let far = t0.max(t1).min_element();
-                // NaN (a zero direction component on a slab's plane) counts as a meeting.
-                !(near > far)
-            }
-        }
-    }
-}
-
-/// What splitting needs of the scene, built once at load ([`tables`]).
-#[derive(Clone, Debug, PartialEq)]
-pub struct SplitTables {
-    /// The area emitters' bounds (ignored with an environment).
-    lights: Vec<LightBound>,
-    /// Is there an environment emitter (every escaping ray meets it)?
-    environment: bool,
-}
-
-impl SplitTables {
-    /// Can a ray meet an emitter that forward tracing hits (an area light or the environment)?
-    #[inline]
-    fn may_hit_emitter(&self, ray: &Ray) -> bool {
-        self.environment || self.lights.iter().any(|b| b.meets(ray))
-    }
-}
 
 /// The splitting tables of `scene` under `opts` (with `connection = complete`), `None` where it
 /// does not run: `split_glints` off, `transport = snee` (it keeps no surface paths), no smooth

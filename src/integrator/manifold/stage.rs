@@ -22,6 +22,7 @@ use crate::bsdf::BsdfSample;
 use crate::color::Spectrum;
 use crate::integrator::cx::Cx;
 use crate::integrator::cx::Scatter;
+use crate::integrator::snee::options::Records;
 use crate::integrator::snee::stage::{clear, shift, Crossing};
 use crate::integrator::snee::{Snee, SneeStage, SneeVertex};
 use crate::integrator::stats::LocalStats;
@@ -30,32 +31,13 @@ use crate::interaction::SurfaceInteraction;
 use crate::math::Vec3;
 use crate::scene::world::{Scene, SceneEmitter};
 
-/// Which of the stage's pending records can ever start in a scene, decided once at scene load
-/// (`volpath_snee::build`, kept in `Snee::records`): a record no connection of the scene can start
-/// is never written, moved or looked up along a path. A record that could start but has no use is
-/// left out too: the curved one is read only at an area light's hit.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Records {
-    /// Through a flat plane of a smooth boundary ([`Pending`], `track.rs`): some medium has a flat
-    /// boundary (`Snee::flat`).
-    pub flat: bool,
-    /// Through a flat or curved rough boundary ([`RoughPending`], `rough.rs`): some medium has one
-    /// (`Snee::rough`).
-    pub rough: bool,
-    /// Through a curved smooth boundary (`curved_finite::Pending`): some medium has one where the
-    /// curved connection applies (`Snee::curved`), and the scene has an area light.
-    pub curved: bool,
-}
-
-impl Records {
-    /// The records `snee`'s manifold tables (built for `scene`) can start.
-    pub fn of(scene: &Scene, snee: &Snee) -> Records {
-        let area_light = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Area { .. }));
-        Records {
-            flat: snee.flat.iter().any(Option::is_some),
-            rough: snee.rough.iter().any(Option::is_some),
-            curved: area_light && snee.curved.iter().any(|&c| c),
-        }
+/// The records `snee`'s manifold tables (built for `scene`) can start (kept in `Snee::records`).
+pub fn records(scene: &Scene, snee: &Snee) -> Records {
+    let area_light = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Area { .. }));
+    Records {
+        flat: snee.flat.iter().any(Option::is_some),
+        rough: snee.rough.iter().any(Option::is_some),
+        curved: area_light && snee.curved.iter().any(|&c| c),
     }
 }
 

@@ -82,7 +82,7 @@ pub struct Snee {
     pub curved: Vec<bool>,
     /// Which pending records the manifold stage keeps in this scene (from the three tables above;
     /// all `false` with `paper`).
-    pub records: crate::integrator::manifold::stage::Records,
+    pub records: Records,
     /// Nothing of `volpath_snee` runs in this scene (no SNEE rate above 0, no manifold connection
     /// or glint that serves its emitters, all transport kept): `li` is then volpath's loop, whose
     /// estimate `volpath_snee`'s would equal (`volpath_snee::forward_only`, docs/snee.md §5).
@@ -95,7 +95,7 @@ pub struct Snee {
     pub meter_glint: Option<crate::integrator::manifold::meter_glint::MeterGlint>,
     /// With `connection = complete` and `split_glints`: what emitter splitting at smooth
     /// dielectric vertices needs of the scene (`manifold::split`); `None` where it does not run.
-    pub split: Option<crate::integrator::manifold::split::SplitTables>,
+    pub split: Option<crate::integrator::manifold::split_bounds::SplitTables>,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).
@@ -115,4 +115,21 @@ impl Connection {
             Connection::Complete => "complete",
         }
     }
+}
+
+/// Which of the stage's pending records can ever start in a scene, decided once at scene load
+/// (`manifold::stage::records`, called by `volpath_snee::build`, kept in `Snee::records`): a record no connection of the scene can start
+/// is never written, moved or looked up along a path. A record that could start but has no use is
+/// left out too: the curved one is read only at an area light's hit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Records {
+    /// Through a flat plane of a smooth boundary (`manifold::track::Pending`): some medium has a flat
+    /// boundary (`Snee::flat`).
+    pub flat: bool,
+    /// Through a flat or curved rough boundary (`manifold::rough::RoughPending`): some medium has one
+    /// (`Snee::rough`).
+    pub rough: bool,
+    /// Through a curved smooth boundary (`curved_finite::Pending`): some medium has one where the
+    /// curved connection applies (`Snee::curved`), and the scene has an area light.
+    pub curved: bool,
 }
