@@ -114,7 +114,9 @@ impl Shape {
         }
     }
 
-    /// (Inlined into `Scene::ray_intersect`: the record is built in place.)
+    /// The surface interaction of a hit on primitive `prim` at barycentrics `(b1, b2)`, distance `t`
+    /// along `ray` (`walk::shadow_crossing`). `Scene::ray_intersect` makes the same dispatch itself,
+    /// returning each arm's record with its `shape` set in place.
     #[inline(always)]
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray: &Ray) -> SurfaceInteraction {
         match &self.geometry {

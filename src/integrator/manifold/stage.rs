@@ -23,7 +23,7 @@ use crate::color::Spectrum;
 use crate::integrator::cx::Cx;
 use crate::integrator::cx::Scatter;
 use crate::integrator::snee::options::Records;
-use crate::integrator::snee::stage::{clear, shift, Crossing};
+use crate::integrator::snee::stage::{clear, set, shift, Crossing};
 use crate::integrator::snee::{Snee, SneeStage, SneeVertex};
 use crate::integrator::stats::LocalStats;
 use crate::interaction::DirectionSample;
@@ -206,13 +206,5 @@ impl<'a> ManifoldStage<'a> {
         clear(&mut self.rough_pending);
         clear(&mut self.curved_pending);
         clear(&mut self.tracker.pending);
-    }
-}
-
-/// `*o = v`, writing nothing when both are `None`.
-#[inline(always)]
-fn set<T>(o: &mut Option<T>, v: Option<T>) {
-    if v.is_some() || o.is_some() {
-        *o = v;
     }
 }

@@ -138,8 +138,8 @@ impl<'a> SneeStage<'a> {
             return;
         }
         match Crossing::of(scene, s, bs, wo) {
-            Crossing::Out => copy_some(&mut self.pending, &self.at_k),
-            Crossing::Passed => copy_some(&mut self.pending, &self.arrived),
+            Crossing::Out => set(&mut self.pending, self.at_k),
+            Crossing::Passed => set(&mut self.pending, self.arrived),
             Crossing::Ends => {}
         }
     }
@@ -182,11 +182,11 @@ pub fn shift<T>(arrived: &mut Option<T>, pending: &mut Option<T>) {
     }
 }
 
-/// `*dst = *src`, writing nothing when both are `None` (for the same records as [`shift`]).
+/// `*o = v`, writing nothing when both are `None` (for the same records as [`shift`]).
 #[inline(always)]
-pub fn copy_some<T: Copy>(dst: &mut Option<T>, src: &Option<T>) {
-    if src.is_some() || dst.is_some() {
-        *dst = *src;
+pub fn set<T>(o: &mut Option<T>, v: Option<T>) {
+    if v.is_some() || o.is_some() {
+        *o = v;
     }
 }
 
