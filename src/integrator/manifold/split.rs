@@ -21,7 +21,8 @@
 //! `p_l · p_l X_l + (1 − p_l) · p_l X_l = p_l X_l`, the term it replaces; lobes outside `S` keep
 //! the forward estimate. The lobe choice still draws its number, so the sample stream is unchanged.
 //! What the split counts is the emitter at the FIRST surface the lobe's ray reaches (or the
-//! environment when it escapes): a hit behind a null surface is made later by the path as before.
+//! environment when it escapes): a hit behind a null surface is made later by the path, as
+//! without splitting.
 //! The path's Russian roulette at the next vertex divides by its survival probability, so the
 //! sampled lobe's scaled hit keeps its expectation; the split lobe counts only where the hit
 //! would (`depth + 1 < max_depth`).
