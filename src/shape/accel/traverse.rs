@@ -47,16 +47,37 @@ impl NodeRay {
     pub fn with_inverse(neg_o: Vec3, d0: Vec4, inv: Vec4) -> NodeRay {
         let finite = inv.abs().cmplt(Vec4::splat(f32::INFINITY));
         let inv_d = Vec4::select(finite, inv, Vec4::splat(f32::MAX).copysign(d0));
-        let neg = d0.cmplt(Vec4::ZERO).bitmask() as usize;
-        // 8 × (row of the near plane): the axis's min row (2a), or its max row when d[a] < 0.
-        let (nx, ny, nz) = ((neg & 1) << 3, (neg & 2) << 2, (neg & 4) << 1);
+        // The w lane (1) is never negative, so the octant is below 8.
+        let [nx, ny, nz, fx, fy, fz] = ROWS[d0.cmplt(Vec4::ZERO).bitmask() as usize & 7];
         NodeRay {
             neg_o: neg_o.to_array(),
             inv_d: inv_d.truncate().to_array(),
-            near: [nx, 16 + ny, 32 + nz],
-            far: [8 - nx, 24 - ny, 40 - nz],
+            near: [nx, ny, nz].map(usize::from),
+            far: [fx, fy, fz].map(usize::from),
         }
     }
+}
+
+/// `NodeRay`'s row offsets (near x, y, z, far x, y, z) by octant (bit `a` set when `d[a] < 0`):
+/// 8 × (row of the near plane), the axis's min row (2a) or its max row when `d[a] < 0`, and the
+/// other row for the far plane. One table row instead of shifts and masks per ray.
+const ROWS: [[u8; 6]; 8] = rows_table();
+
+/// The rows of [`ROWS`].
+const fn rows_table() -> [[u8; 6]; 8] {
+    let mut t = [[0; 6]; 8];
+    let mut octant = 0;
+    while octant < 8 {
+        let mut a = 0;
+        while a < 3 {
+            let neg = (octant >> a) & 1;
+            t[octant][a] = (8 * (2 * a + neg)) as u8;
+            t[octant][3 + a] = (8 * (2 * a + 1 - neg)) as u8;
+            a += 1;
+        }
+        octant += 1;
+    }
+    t
 }
 
 /// Everything the traversal needs of one ray, computed once per ray with one division: the node
