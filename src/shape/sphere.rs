@@ -12,6 +12,7 @@
 
 use crate::interaction::{shading_frame, DirectionSample, PositionSample, SurfaceInteraction};
 use crate::math::{warp, Aabb, Frame, Mat4, Ray, Vec2, Vec3, INV_PI, INV_TWO_PI, PI};
+use glam::Vec3A;
 
 #[derive(Clone, Debug)]
 pub struct Sphere {
@@ -167,6 +168,13 @@ impl Sphere {
 /// (q = b − √disc < 0, so t1 = q / a < 0 and t0 = c / q < 0), so the result is the same bit for bit.
 #[inline(always)]
 pub fn intersect_sphere(center: Vec3, r2: f32, o: Vec3, d: Vec3, tmax: f32) -> Option<f32> {
+    intersect_sphere_a(center.into(), r2, o.into(), d.into(), tmax)
+}
+
+/// [`intersect_sphere`] on 16-byte vectors (the BVH's analytic test): the same operations in the
+/// same order (glam's `Vec3A::dot` adds (x + y) + z as `Vec3::dot` does), so the same bits.
+#[inline(always)]
+pub fn intersect_sphere_a(center: Vec3A, r2: f32, o: Vec3A, d: Vec3A, tmax: f32) -> Option<f32> {
     let f = o - center;
     // The quadratic a t² − 2 b t + c = 0 with b = −f·d, c = |f|² − r².
     let b = -f.dot(d);

@@ -17,10 +17,10 @@ use super::{Geometry, Shape};
 use crate::math::Ray;
 use build::Bounds;
 use bvh8::Bvh8;
-use glam::{Vec3, Vec3A};
+use glam::Vec3A;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
-use traverse::STACK;
+use traverse::{Found, STACK};
 
 /// Closest hit: shape, primitive, barycentrics of vertices 1 and 2, distance.
 #[derive(Clone, Copy, Debug)]
@@ -58,18 +58,21 @@ impl Isa {
 
 pub struct Accel {
     bvh: Option<Bvh8>,
-    /// Shapes tested outside the BVH (spheres, disks).
-    analytic: Vec<Analytic>,
+    /// Spheres tested outside the BVH, with what their test needs copied out of the shapes.
+    spheres: Vec<AnalyticSphere>,
+    /// Disks tested outside the BVH (their shape indices).
+    disks: Vec<u32>,
     isa: Isa,
     /// The tree is too deep for the fixed traversal stack (`traverse::STACK`): queries use a heap one.
     deep: bool,
 }
 
-/// A shape tested outside the BVH, with what its test needs copied out of the shape.
+/// A sphere tested outside the BVH: centre and r² (16-byte vectors: the test runs in SSE lanes).
 #[derive(Clone, Copy, Debug)]
-enum Analytic {
-    Sphere { shape: u32, center: Vec3, r2: f32 },
-    Disk { shape: u32 },
+struct AnalyticSphere {
+    center: Vec3A,
+    r2: f32,
+    shape: u32,
 }
 
 impl Accel {
@@ -85,7 +88,7 @@ impl Accel {
         // meshes one after another.
         let mut mesh_starts = Vec::new();
         let mut bounds = Vec::new();
-        let mut analytic = Vec::new();
+        let (mut spheres, mut disks) = (Vec::new(), Vec::new());
         for (si, s) in shapes.iter().enumerate() {
             match &s.geometry {
                 Geometry::Mesh(m) => {
@@ -102,10 +105,12 @@ impl Accel {
                         b
                     }));
                 }
-                Geometry::Sphere(sp) => {
-                    analytic.push(Analytic::Sphere { shape: si as u32, center: sp.center, r2: sp.radius * sp.radius })
-                }
-                Geometry::Disk(_) => analytic.push(Analytic::Disk { shape: si as u32 }),
+                Geometry::Sphere(sp) => spheres.push(AnalyticSphere {
+                    center: sp.center.into(),
+                    r2: sp.radius * sp.radius,
+                    shape: si as u32,
+                }),
+                Geometry::Disk(_) => disks.push(si as u32),
             }
         }
         let bvh = build::build(bounds, |id| {
@@ -116,7 +121,7 @@ impl Accel {
             }
         });
         let deep = bvh.as_ref().is_some_and(|b| traverse::stack_size(b.depth) > STACK);
-        Accel { bvh, analytic, isa, deep }
+        Accel { bvh, spheres, disks, isa, deep }
     }
 
     /// Bytes of the BVH (nodes, triangle packets, per-lane shape and triangle).
@@ -166,29 +171,39 @@ impl Accel {
     }
 
     /// The analytic shapes' closest hit in (0, ray.tmax), and the distance the BVH must beat.
+    /// Spheres are tested before disks; a disk at exactly a sphere's distance wins when its shape
+    /// comes first, so the hit is the one of the lowest shape index among the nearest, as a test
+    /// of the shapes in scene order gives it.
     #[inline(always)]
     fn analytic_closest(&self, shapes: &[Shape], ray: &Ray) -> (Option<Hit>, f32) {
-        let mut best = None;
+        let mut best: Option<Hit> = None;
         let mut tmax = ray.tmax;
-        for a in &self.analytic {
-            let (shape, t) = analytic_hit(a, shapes, ray, tmax);
-            if t < tmax {
-                tmax = t;
-                best = Some(Hit { shape, prim: 0, b1: 0.0, b2: 0.0, t });
+        let (o, d) = (Vec3A::from(ray.o), Vec3A::from(ray.d));
+        for s in &self.spheres {
+            if let Some(t) = super::sphere::intersect_sphere_a(s.center, s.r2, o, d, tmax) {
+                if t < tmax {
+                    tmax = t;
+                    best = Some(Hit { shape: s.shape, prim: 0, b1: 0.0, b2: 0.0, t });
+                }
             }
+        }
+        if !self.disks.is_empty() {
+            (best, tmax) = disks_closest(&self.disks, shapes, ray, best, tmax);
         }
         (best, tmax)
     }
 
     #[inline(always)]
     fn analytic_any(&self, shapes: &[Shape], ray: &Ray) -> bool {
-        self.analytic.iter().any(|a| analytic_hit(a, shapes, ray, ray.tmax).1 < ray.tmax)
+        let (o, d) = (Vec3A::from(ray.o), Vec3A::from(ray.d));
+        self.spheres.iter().any(|s| super::sphere::intersect_sphere_a(s.center, s.r2, o, d, ray.tmax).is_some())
+            || (!self.disks.is_empty() && disks_any(&self.disks, shapes, ray))
     }
 
     /// The BVH's closest hit in (0, tmax): one call into the traversal compiled for the CPU (the
     /// ray's precomputation happens inside it).
     #[inline(always)]
-    fn closest(&self, bvh: &Bvh8, ray: &Ray, tmax: f32) -> Option<(u32, f32, f32, f32)> {
+    fn closest(&self, bvh: &Bvh8, ray: &Ray, tmax: f32) -> Found {
         if self.deep {
             return closest_deep(bvh, ray, tmax, self.isa);
         }
@@ -196,9 +211,9 @@ impl Accel {
         #[cfg(target_arch = "x86_64")]
         if self.isa == Isa::Avx2 {
             // SAFETY: `Isa::Avx2` is only set when the CPU supports it (checked in `build_with`).
-            return unsafe { traverse::closest_avx2(bvh, ray.o, ray.d, tmax, stack) };
+            return unsafe { traverse::closest_avx2(bvh, ray, tmax, stack) };
         }
-        traverse::closest_portable(bvh, ray.o, ray.d, tmax, stack)
+        traverse::closest_portable(bvh, ray, tmax, stack)
     }
 
     #[inline(always)]
@@ -210,16 +225,19 @@ impl Accel {
         #[cfg(target_arch = "x86_64")]
         if self.isa == Isa::Avx2 {
             // SAFETY: as in `closest`.
-            return unsafe { traverse::any_avx2(bvh, ray.o, ray.d, ray.tmax, stack) };
+            return unsafe { traverse::any_avx2(bvh, ray, stack) };
         }
-        traverse::any_portable(bvh, ray.o, ray.d, ray.tmax, stack)
+        traverse::any_portable(bvh, ray, stack)
     }
 }
 
 /// The BVH's hit as a `Hit` (shape and triangle of the lane).
 #[inline(always)]
-fn bvh_hit(bvh: &Bvh8, found: Option<(u32, f32, f32, f32)>) -> Option<Hit> {
-    let (lane, t, b1, b2) = found?;
+fn bvh_hit(bvh: &Bvh8, found: Found) -> Option<Hit> {
+    if found.lane == u32::MAX {
+        return None;
+    }
+    let (lane, t, b1, b2) = (found.lane, found.t, found.b1, found.b2);
     let (shape, prim) = bvh.lane_prims[lane as usize / 4][lane as usize % 4];
     Some(Hit { shape, prim, b1, b2, t })
 }
@@ -227,15 +245,15 @@ fn bvh_hit(bvh: &Bvh8, found: Option<(u32, f32, f32, f32)>) -> Option<Hit> {
 /// Closest hit in a tree too deep for the fixed stack (a heap stack).
 #[cold]
 #[inline(never)]
-fn closest_deep(bvh: &Bvh8, ray: &Ray, tmax: f32, isa: Isa) -> Option<(u32, f32, f32, f32)> {
+fn closest_deep(bvh: &Bvh8, ray: &Ray, tmax: f32, isa: Isa) -> Found {
     let stack = &mut heap_stack(bvh.depth);
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx2 {
         // SAFETY: `Isa::Avx2` is only set when the CPU supports it.
-        return unsafe { traverse::closest_avx2(bvh, ray.o, ray.d, tmax, stack) };
+        return unsafe { traverse::closest_avx2(bvh, ray, tmax, stack) };
     }
     let _ = isa;
-    traverse::closest_portable(bvh, ray.o, ray.d, tmax, stack)
+    traverse::closest_portable(bvh, ray, tmax, stack)
 }
 
 /// Any hit in a tree too deep for the fixed stack.
@@ -246,10 +264,10 @@ fn any_deep(bvh: &Bvh8, ray: &Ray, isa: Isa) -> bool {
     #[cfg(target_arch = "x86_64")]
     if isa == Isa::Avx2 {
         // SAFETY: as in `closest_deep`.
-        return unsafe { traverse::any_avx2(bvh, ray.o, ray.d, ray.tmax, stack) };
+        return unsafe { traverse::any_avx2(bvh, ray, stack) };
     }
     let _ = isa;
-    traverse::any_portable(bvh, ray.o, ray.d, ray.tmax, stack)
+    traverse::any_portable(bvh, ray, stack)
 }
 
 /// Shape and triangle of builder index `id`.
@@ -264,33 +282,45 @@ fn heap_stack(depth: usize) -> Vec<MaybeUninit<traverse::Entry>> {
     vec![MaybeUninit::uninit(); traverse::stack_size(depth)]
 }
 
-/// The shape of `a` and its hit distance in (0, tmax) (`f32::INFINITY` when none).
-#[inline(always)]
-fn analytic_hit(a: &Analytic, shapes: &[Shape], ray: &Ray, tmax: f32) -> (u32, f32) {
-    match *a {
-        Analytic::Sphere { shape, center, r2 } => {
-            (shape, super::sphere::intersect_sphere(center, r2, ray.o, ray.d, tmax).unwrap_or(f32::INFINITY))
-        }
-        Analytic::Disk { shape } => {
-            let t = match &shapes[shape as usize].geometry {
-                Geometry::Disk(d) => d.intersect(&Ray { o: ray.o, d: ray.d, tmax }),
-                _ => None,
-            };
-            (shape, t.unwrap_or(f32::INFINITY))
+/// The disks' closest hit after the spheres' (`best` at distance `tmax`): see
+/// [`Accel::analytic_closest`] for the order. Out of line: few scenes hold disks.
+#[inline(never)]
+fn disks_closest(
+    disks: &[u32],
+    shapes: &[Shape],
+    ray: &Ray,
+    mut best: Option<Hit>,
+    mut tmax: f32,
+) -> (Option<Hit>, f32) {
+    for &shape in disks {
+        let Geometry::Disk(disk) = &shapes[shape as usize].geometry else { continue };
+        let Some(t) = disk.intersect(&Ray { o: ray.o, d: ray.d, tmax: ray.tmax }) else { continue };
+        if t < tmax || (t == tmax && best.is_some_and(|b| shape < b.shape)) {
+            tmax = t;
+            best = Some(Hit { shape, prim: 0, b1: 0.0, b2: 0.0, t });
         }
     }
+    (best, tmax)
+}
+
+/// True when a disk blocks the ray in (0, ray.tmax).
+#[inline(never)]
+fn disks_any(disks: &[u32], shapes: &[Shape], ray: &Ray) -> bool {
+    disks.iter().any(|&shape| match &shapes[shape as usize].geometry {
+        Geometry::Disk(disk) => disk.intersect(ray).is_some(),
+        _ => false,
+    })
 }
 
 #[cfg(test)]
 mod tests;
 
 /// Origin and direction finite (a sum is non-finite when either part is, even ±inf cancelling to NaN).
-/// `x − x` is exactly 0 for a finite `x` and NaN otherwise, so the three differences sum to 0 exactly
-/// when every component is finite: one comparison instead of one per component.
+/// `x − x` is exactly 0 for a finite `x` and NaN otherwise, so one vector comparison of the three
+/// differences with 0 tests every component.
 #[inline(always)]
 #[allow(clippy::eq_op)] // `s - s` is the finiteness test, not zero
 fn ray_is_finite(ray: &Ray) -> bool {
-    let s = ray.o + ray.d;
-    let z = s - s;
-    z.x + z.y + z.z == 0.0
+    let s = Vec3A::from(ray.o) + Vec3A::from(ray.d);
+    (s - s).cmpeq(Vec3A::ZERO).all()
 }

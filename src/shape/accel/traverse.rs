@@ -10,7 +10,7 @@
 
 use super::bvh8::{Bvh8, Node8, EMPTY, LEAF};
 use super::triangle::WatertightRay;
-use crate::math::Vec3;
+use crate::math::{Ray, Vec3};
 use glam::Vec4;
 use std::mem::MaybeUninit;
 
@@ -47,16 +47,37 @@ impl NodeRay {
     pub fn with_inverse(neg_o: Vec3, d0: Vec4, inv: Vec4) -> NodeRay {
         let finite = inv.abs().cmplt(Vec4::splat(f32::INFINITY));
         let inv_d = Vec4::select(finite, inv, Vec4::splat(f32::MAX).copysign(d0));
-        let neg = d0.cmplt(Vec4::ZERO).bitmask() as usize;
-        // 8 × (row of the near plane): the axis's min row (2a), or its max row when d[a] < 0.
-        let (nx, ny, nz) = ((neg & 1) << 3, (neg & 2) << 2, (neg & 4) << 1);
+        // The w lane (1) is never negative, so the octant is below 8.
+        let [nx, ny, nz, fx, fy, fz] = ROWS[d0.cmplt(Vec4::ZERO).bitmask() as usize & 7];
         NodeRay {
             neg_o: neg_o.to_array(),
             inv_d: inv_d.truncate().to_array(),
-            near: [nx, 16 + ny, 32 + nz],
-            far: [8 - nx, 24 - ny, 40 - nz],
+            near: [nx, ny, nz].map(usize::from),
+            far: [fx, fy, fz].map(usize::from),
         }
     }
+}
+
+/// `NodeRay`'s row offsets (near x, y, z, far x, y, z) by octant (bit `a` set when `d[a] < 0`):
+/// 8 × (row of the near plane), the axis's min row (2a) or its max row when `d[a] < 0`, and the
+/// other row for the far plane. One table row instead of shifts and masks per ray.
+const ROWS: [[u8; 6]; 8] = rows_table();
+
+/// The rows of [`ROWS`].
+const fn rows_table() -> [[u8; 6]; 8] {
+    let mut t = [[0; 6]; 8];
+    let mut octant = 0;
+    while octant < 8 {
+        let mut a = 0;
+        while a < 3 {
+            let neg = (octant >> a) & 1;
+            t[octant][a] = (8 * (2 * a + neg)) as u8;
+            t[octant][3 + a] = (8 * (2 * a + 1 - neg)) as u8;
+            a += 1;
+        }
+        octant += 1;
+    }
+    t
 }
 
 /// Everything the traversal needs of one ray, computed once per ray with one division: the node
@@ -83,8 +104,18 @@ impl TraceRay {
 /// each child's entry distance in `t_near`.
 #[inline(always)]
 pub fn node_test_portable(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f32; 8]) -> u32 {
+    let (mask, tn) = node_test_portable_near(node, r, tmax);
+    store_near_portable(tn, t_near);
+    mask
+}
+
+/// [`node_test_portable`] with the entry distances returned as two vectors (lanes 0–3, 4–7), so
+/// the traversal stores them only where it orders two or more children.
+#[inline(always)]
+pub fn node_test_portable_near(node: &Node8, r: &NodeRay, tmax: f32) -> (u32, [Vec4; 2]) {
     let mut mask = 0;
-    for h in 0..2 {
+    let mut tns = [Vec4::ZERO; 2];
+    for (h, tns) in tns.iter_mut().enumerate() {
         let row = |off: usize| Vec4::from_slice(&node.bounds.as_flattened()[off + 4 * h..off + 4 * h + 4]);
         let slab = |a: usize| {
             let (neg_o, inv) = (Vec4::splat(r.neg_o[a]), Vec4::splat(r.inv_d[a]));
@@ -96,18 +127,25 @@ pub fn node_test_portable(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f3
         let tn = nx.max(ny).max(nz.max(Vec4::ZERO));
         let tf = (fx.min(fy).min(fz) * Vec4::splat(FAR_SCALE)).min(Vec4::splat(tmax));
         mask |= tn.cmple(tf).bitmask() << (4 * h);
-        tn.write_to_slice(&mut t_near[4 * h..4 * h + 4]);
+        *tns = tn;
     }
-    mask
+    (mask, tns)
+}
+
+/// The entry distances of [`node_test_portable_near`] into `t_near`.
+#[inline(always)]
+fn store_near_portable(tn: [Vec4; 2], t_near: &mut [f32; 8]) {
+    tn[0].write_to_slice(&mut t_near[..4]);
+    tn[1].write_to_slice(&mut t_near[4..]);
 }
 
 /// The same slab test in one AVX register per plane (a macro so that it inlines into the AVX2
 /// traversal; see `node_test_avx` for a callable version).
 #[cfg(target_arch = "x86_64")]
 macro_rules! node_test_avx_body {
-    ($node:expr, $r:expr, $tmax:expr, $t_near:expr) => {{
+    ($node:expr, $r:expr, $tmax:expr) => {{
         use std::arch::x86_64::*;
-        let (node, r, tmax, t_near): (&Node8, &NodeRay, f32, &mut [f32; 8]) = ($node, $r, $tmax, $t_near);
+        let (node, r, tmax): (&Node8, &NodeRay, f32) = ($node, $r, $tmax);
         macro_rules! slab {
             ($a:expr) => {{
                 let neg_o = _mm256_set1_ps(r.neg_o[$a]);
@@ -124,8 +162,18 @@ macro_rules! node_test_avx_body {
         let tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_setzero_ps()));
         let tf = _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(fx, fy), fz), _mm256_set1_ps(FAR_SCALE));
         let tf = _mm256_min_ps(tf, _mm256_set1_ps(tmax));
-        _mm256_storeu_ps(t_near.as_mut_ptr(), tn);
-        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as u32
+        (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as u32, tn)
+    }};
+}
+
+/// The entry distances of [`node_test_avx_body`] into `t_near` (written only where the traversal
+/// orders two or more children).
+#[cfg(target_arch = "x86_64")]
+macro_rules! store_near_avx {
+    ($tn:expr, $t_near:expr) => {{
+        let t_near: &mut [f32; 8] = $t_near;
+        // SAFETY: `t_near` holds eight floats.
+        unsafe { std::arch::x86_64::_mm256_storeu_ps(t_near.as_mut_ptr(), $tn) }
     }};
 }
 
@@ -136,13 +184,22 @@ macro_rules! node_test_avx_body {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
 pub unsafe fn node_test_avx(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f32; 8]) -> u32 {
-    node_test_avx_body!(node, r, tmax, t_near)
+    let (mask, tn) = node_test_avx_body!(node, r, tmax);
+    store_near_avx!(tn, t_near);
+    mask
 }
 
-/// `node_test_portable` in the form the traversal macros take.
+/// `node_test_portable_near` in the form the traversal macros take.
 macro_rules! node_test_portable_body {
-    ($node:expr, $r:expr, $tmax:expr, $t_near:expr) => {
-        node_test_portable($node, $r, $tmax, $t_near)
+    ($node:expr, $r:expr, $tmax:expr) => {
+        node_test_portable_near($node, $r, $tmax)
+    };
+}
+
+/// `store_near_portable` in the form the traversal macros take.
+macro_rules! store_near_portable_body {
+    ($tn:expr, $t_near:expr) => {
+        store_near_portable($tn, $t_near)
     };
 }
 
@@ -155,10 +212,28 @@ pub struct Entry {
     pub t: f32,
 }
 
-/// Stack size that suffices for a tree of depth `depth`: at most 7 entries pushed per level, and
-/// room for the AVX2 ordering, which writes eight entries from the top (`order_push_avx2`).
+/// Stack size that suffices for a tree of depth `depth`: the closest-hit traversal's sentinel, at
+/// most 7 entries pushed per level, and room for the AVX2 ordering, which writes eight entries from
+/// the top (`order_push_avx2`).
 pub fn stack_size(depth: usize) -> usize {
-    7 * depth + 8
+    1 + 7 * depth + 8
+}
+
+/// The closest-hit traversal's bottom stack entry: its child ends the traversal, and its distance
+/// (−∞) is never culled, so popping needs no test for an empty stack. It has the `LEAF` bit set
+/// (so the descent stops at it) and is neither `EMPTY` nor a packet (the builder makes fewer than
+/// 2³¹ − 2 packets).
+const DONE: u32 = EMPTY - 1;
+
+/// The closest hit the traversal found: its lane (index into `lane_prims` read as one array of
+/// lanes; `u32::MAX` when nothing was hit), distance and barycentrics of vertices 1 and 2. Sixteen
+/// bytes, returned in registers.
+#[derive(Clone, Copy, Debug)]
+pub struct Found {
+    pub lane: u32,
+    pub t: f32,
+    pub b1: f32,
+    pub b2: f32,
 }
 
 /// Fixed stack size used when the tree allows it (deeper trees use a heap stack).
@@ -267,24 +342,25 @@ macro_rules! order_push_avx2 {
     }};
 }
 
-/// Closest-hit traversal with node test `$node_test`: `(lane index into lane_prims, t, b1, b2)`
-/// of the nearest triangle in (0, tmax). A macro, so that each instance is compiled with the
-/// target features of the function it expands in and the node test inlines.
+/// Closest-hit traversal with node test `$node_test`: the nearest triangle in (0, tmax) as a
+/// [`Found`]. A macro, so that each instance is compiled with the target features of the function
+/// it expands in and the node test inlines.
 macro_rules! closest_body {
-    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident, $order:ident, $chk:ident) => {{
-        let (bvh, mut tmax, stack): (&Bvh8, f32, &mut Stack) = ($bvh, $tmax, $stack);
-        let tr = TraceRay::new($o, $d);
+    ($bvh:expr, $ray:expr, $tmax:expr, $stack:expr, $node_test:ident, $store:ident, $order:ident, $chk:ident) => {{
+        let (bvh, ray, mut tmax, stack): (&Bvh8, &Ray, f32, &mut Stack) = ($bvh, $ray, $tmax, $stack);
+        let tr = TraceRay::new(ray.o, ray.d);
         let (nr, wt) = (&tr.node, &tr.wt);
         // The nearest hit so far: its lane (`u32::MAX` while none) and barycentrics; its distance is `tmax`.
         let (mut hit_lane, mut hit_b1, mut hit_b2) = (u32::MAX, 0.0f32, 0.0f32);
-        let mut sp = 0usize;
+        *at_mut!($chk, stack, 0) = MaybeUninit::new(Entry { child: DONE, t: f32::NEG_INFINITY });
+        let mut sp = 1usize;
         let mut cur = bvh.root;
         let mut t_near = [0.0f32; 8];
-        'traversal: loop {
+        loop {
             // Descend through inner nodes to the nearest hit child until a leaf (or nothing) is next.
             while cur & LEAF == 0 {
                 let node = at!($chk, bvh.nodes, cur as usize);
-                let mask = $node_test!(node, nr, tmax, &mut t_near);
+                let (mask, tn) = $node_test!(node, nr, tmax);
                 if mask == 0 {
                     cur = EMPTY;
                     break;
@@ -295,6 +371,7 @@ macro_rules! closest_body {
                 }
                 // Two or more: order by entry distance (non-negative, so its bits sort as integers;
                 // the low three bits carry the slot), push all but the nearest, farthest first.
+                $store!(tn, &mut t_near);
                 let key = |slot: u32| (t_near[slot as usize].to_bits() & !7) | slot;
                 let first = mask.trailing_zeros();
                 let rest = mask & (mask - 1);
@@ -311,22 +388,22 @@ macro_rules! closest_body {
                 // Three or more: all but the nearest pushed, farthest first.
                 cur = $order!(node, mask, &t_near, &mut *stack, sp, key);
             }
-            if cur != EMPTY {
+            if cur < DONE {
                 let packet = (cur & !LEAF) as usize;
                 if let Some((lane, t, b1, b2)) = wt.nearest4(at!($chk, bvh.packets, packet), tmax) {
                     (hit_lane, tmax, hit_b1, hit_b2) = ((4 * packet + lane) as u32, t, b1, b2);
                 }
+            } else if cur == DONE {
+                break Found { lane: hit_lane, t: tmax, b1: hit_b1, b2: hit_b2 };
             }
-            // Pop the nearest remaining child that may still hold a closer hit.
+            // Pop the nearest remaining child that may still hold a closer hit (the sentinel at
+            // the bottom always qualifies; `!(t > tmax)` also takes it for a NaN `tmax`).
             loop {
-                if sp == 0 {
-                    break 'traversal (hit_lane != u32::MAX).then_some((hit_lane, tmax, hit_b1, hit_b2));
-                }
                 sp -= 1;
                 // SAFETY: entries below `sp` were written.
                 let e = *at!($chk, stack, sp);
                 let e = unsafe { e.assume_init() };
-                if e.t <= tmax {
+                if !(e.t > tmax) {
                     cur = e.child;
                     break;
                 }
@@ -337,17 +414,17 @@ macro_rules! closest_body {
 
 /// Any-hit traversal with node test `$node_test`: true when a triangle is hit in (0, tmax).
 macro_rules! any_body {
-    ($bvh:expr, $o:expr, $d:expr, $tmax:expr, $stack:expr, $node_test:ident, $chk:ident) => {{
-        let (bvh, tmax, stack): (&Bvh8, f32, &mut Stack) = ($bvh, $tmax, $stack);
-        let tr = TraceRay::new($o, $d);
+    ($bvh:expr, $ray:expr, $stack:expr, $node_test:ident, $chk:ident) => {{
+        let (bvh, ray, stack): (&Bvh8, &Ray, &mut Stack) = ($bvh, $ray, $stack);
+        let tmax = ray.tmax;
+        let tr = TraceRay::new(ray.o, ray.d);
         let (nr, wt) = (&tr.node, &tr.wt);
         let mut sp = 0usize;
         let mut cur = bvh.root;
-        let mut t_near = [0.0f32; 8];
         loop {
             if cur & LEAF == 0 {
                 let node = at!($chk, bvh.nodes, cur as usize);
-                let mut mask = $node_test!(node, nr, tmax, &mut t_near);
+                let (mut mask, _) = $node_test!(node, nr, tmax);
                 if mask != 0 {
                     // Descend into the hit child of the highest slot; push the others (lowest
                     // first, so they are visited from the highest down).
@@ -377,13 +454,23 @@ macro_rules! any_body {
 }
 
 /// Closest hit, portable node test.
-pub fn closest_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
-    closest_body!(bvh, o, d, tmax, stack, node_test_portable_body, order_push_portable, checked)
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t > tmax)`: see the pop in `closest_body`
+pub fn closest_portable(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
+    closest_body!(
+        bvh,
+        ray,
+        tmax,
+        stack,
+        node_test_portable_body,
+        store_near_portable_body,
+        order_push_portable,
+        checked
+    )
 }
 
 /// Any hit, portable node test.
-pub fn any_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> bool {
-    any_body!(bvh, o, d, tmax, stack, node_test_portable_body, checked)
+pub fn any_portable(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+    any_body!(bvh, ray, stack, node_test_portable_body, checked)
 }
 
 /// Closest hit, AVX node test.
@@ -394,8 +481,9 @@ pub fn any_portable(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) 
 /// hold at least `stack_size(bvh.depth)` entries: the traversal indexes both without bounds checks.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
-pub unsafe fn closest_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> Option<(u32, f32, f32, f32)> {
-    closest_body!(bvh, o, d, tmax, stack, node_test_avx_body, order_push_avx2, unchecked)
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t > tmax)`: see the pop in `closest_body`
+pub unsafe fn closest_avx2(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
+    closest_body!(bvh, ray, tmax, stack, node_test_avx_body, store_near_avx, order_push_avx2, unchecked)
 }
 
 /// Any hit, AVX node test.
@@ -404,6 +492,6 @@ pub unsafe fn closest_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut 
 /// As for `closest_avx2`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
-pub unsafe fn any_avx2(bvh: &Bvh8, o: Vec3, d: Vec3, tmax: f32, stack: &mut Stack) -> bool {
-    any_body!(bvh, o, d, tmax, stack, node_test_avx_body, unchecked)
+pub unsafe fn any_avx2(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+    any_body!(bvh, ray, stack, node_test_avx_body, unchecked)
 }

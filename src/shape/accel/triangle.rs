@@ -89,8 +89,8 @@ const fn axes_table() -> [[u8; 3]; 64] {
 /// Per-ray precomputation of the watertight test (Woop et al. 2013, Sec. 3).
 #[derive(Clone, Copy, Debug)]
 pub struct WatertightRay {
-    /// Axes (kx, ky, kz), each as 4 × axis: where the axis's row starts in a vertex's
-    /// `[[f32; 4]; 3]` read as one array (so a visit adds it to the address as it is).
+    /// Axes (kx, ky, kz), each as 16 × axis: the byte offset of the axis's row in a vertex's
+    /// `[[f32; 4]; 3]` (so a visit adds it to the address as it is, with no scaling).
     k: [usize; 3],
     /// Shear (sx, sy, sz, 0), one vector: a leaf visit broadcasts each lane from memory as it
     /// would load a splatted copy, and the per-ray setup stores one vector instead of three.
@@ -122,9 +122,9 @@ fn edges_f64(ray: WatertightRay, p: &TriPacket4, lanes: u32, uvw: [Vec4; 3]) -> 
 #[inline(always)]
 fn sheared(w: &WatertightRay, p: &TriPacket4, j: usize) -> (Vec4, Vec4, Vec4) {
     let v = &p.v[j];
-    // SAFETY: `w.k` holds 4 × axis with axis < 3 (set only by `from_parts` and `with_inverse_d0`),
-    // so the four floats from each offset are one row of `v`.
-    let row = |k: usize| unsafe { Vec4::from_array(*v.as_ptr().cast::<f32>().add(k).cast::<[f32; 4]>()) };
+    // SAFETY: `w.k` holds 16 × axis with axis < 3 (set only by `from_parts` and `with_inverse_d0`),
+    // so the 16 bytes from each offset are one row of `v`.
+    let row = |k: usize| unsafe { Vec4::from_array(*v.as_ptr().cast::<u8>().add(k).cast::<[f32; 4]>()) };
     let rx = row(w.k[0]) + Vec4::splat(w.neg_o.x);
     let ry = row(w.k[1]) + Vec4::splat(w.neg_o.y);
     let rz = row(w.k[2]) + Vec4::splat(w.neg_o.z);
@@ -142,7 +142,7 @@ impl WatertightRay {
     pub fn from_parts(k: [usize; 3], s: [f32; 3], o: Vec3) -> Self {
         assert!(k.iter().all(|&a| a < 3), "axes {k:?}");
         WatertightRay {
-            k: k.map(|a| 4 * a),
+            k: k.map(|a| 16 * a),
             s: Vec4::new(s[0], s[1], s[2], 0.0),
             neg_o: Vec4::new(-o[k[0]], -o[k[1]], -o[k[2]], 0.0),
         }
@@ -180,7 +180,7 @@ impl WatertightRay {
             )
         };
         WatertightRay {
-            k: [4 * kx, 4 * ky, 4 * kz],
+            k: [16 * kx, 16 * ky, 16 * kz],
             s: Vec4::new(dx * sz, dy * sz, *sz, 0.0),
             neg_o: Vec4::new(*ox, *oy, *oz, 0.0),
         }
