@@ -138,47 +138,74 @@ pub fn shadow_transmittance(
     }
     let mut tr = Spectrum::ONE;
     let mut remaining = ray.tmax;
-    for _ in 0..MAX_SEGMENTS {
-        if !(remaining > 0.0) {
-            break;
-        }
-        let m = medium.map(|m| &scene.media[m as usize]);
-        let t = m.map_or(f32::INFINITY, |m| m.sample_distance(sampler.next_1d(), channel));
-        // Up to and including `t`: a surface exactly at `t` is crossed, as with `t < seg` below.
-        ray.tmax = if t < remaining { t.next_up() } else { remaining };
-        stats.rays += 1;
-        // The hit alone (`Scene::ray_intersect`'s query); the crossing below builds what it needs of it.
-        let hit = scene.accel.intersect_inline(&scene.shapes, &ray);
-        let seg = hit.as_ref().map_or(remaining, |h| h.t);
-        if let Some(m) = m {
-            if t < seg {
-                // A real collision: homogeneous media have no null density, the estimate is 0.
-                return Spectrum::ZERO;
-            }
-            if seg.is_finite() {
-                let t_seg = m.transmittance(seg);
-                let p = t_seg[channel];
-                if !(p > 0.0) {
-                    return Spectrum::ZERO;
-                }
-                tr *= t_seg / p;
+    // The first segment is written out before the loop: most walks end in it, and the loop's
+    // set-up (the scene's fields it keeps at hand) is then paid only by walks of two or more.
+    if shadow_segment(scene, &mut ray, &mut medium, &mut remaining, &mut tr, channel, sampler, stats) {
+        for _ in 1..MAX_SEGMENTS {
+            if !shadow_segment(scene, &mut ray, &mut medium, &mut remaining, &mut tr, channel, sampler, stats) {
+                break;
             }
         }
-        let Some(hit) = hit else { break };
-        let (p, n, null_transmission) = shadow_crossing(scene, &hit, &ray);
-        tr *= null_transmission;
-        if tr == Spectrum::ZERO {
-            break;
-        }
-        // `is_medium_transition` and `target_medium` on the crossing's shape and normal.
-        let s = &scene.shapes[hit.shape as usize];
-        if s.interior.is_some() || s.exterior.is_some() {
-            medium = if ray.d.dot(n) > 0.0 { s.exterior } else { s.interior };
-        }
-        remaining -= hit.t;
-        ray.o = offset_origin(p, n, ray.d);
     }
     tr
+}
+
+/// One segment of [`shadow_transmittance`]'s walk: the distance sample, the trace up to it, the
+/// segment's transmittance into `tr` and the crossing of the surface that ends it. Returns whether
+/// the walk goes on (`false`: it ended, with its value in `tr`).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn shadow_segment(
+    scene: &Scene,
+    ray: &mut Ray,
+    medium: &mut Option<u32>,
+    remaining: &mut f32,
+    tr: &mut Spectrum,
+    channel: usize,
+    sampler: &mut Sampler,
+    stats: &mut LocalStats,
+) -> bool {
+    if !(*remaining > 0.0) {
+        return false;
+    }
+    let m = medium.map(|m| &scene.media[m as usize]);
+    let t = m.map_or(f32::INFINITY, |m| m.sample_distance(sampler.next_1d(), channel));
+    // Up to and including `t`: a surface exactly at `t` is crossed, as with `t < seg` below.
+    ray.tmax = if t < *remaining { t.next_up() } else { *remaining };
+    stats.rays += 1;
+    // The hit alone (`Scene::ray_intersect`'s query); the crossing below builds what it needs of it.
+    let hit = scene.accel.intersect_inline(&scene.shapes, ray);
+    let seg = hit.as_ref().map_or(*remaining, |h| h.t);
+    if let Some(m) = m {
+        if t < seg {
+            // A real collision: homogeneous media have no null density, the estimate is 0.
+            *tr = Spectrum::ZERO;
+            return false;
+        }
+        if seg.is_finite() {
+            let t_seg = m.transmittance(seg);
+            let p = t_seg[channel];
+            if !(p > 0.0) {
+                *tr = Spectrum::ZERO;
+                return false;
+            }
+            *tr *= t_seg / p;
+        }
+    }
+    let Some(hit) = hit else { return false };
+    let (p, n, null_transmission) = shadow_crossing(scene, &hit, ray);
+    *tr *= null_transmission;
+    if *tr == Spectrum::ZERO {
+        return false;
+    }
+    // `is_medium_transition` and `target_medium` on the crossing's shape and normal.
+    let s = &scene.shapes[hit.shape as usize];
+    if s.interior.is_some() || s.exterior.is_some() {
+        *medium = if ray.d.dot(n) > 0.0 { s.exterior } else { s.interior };
+    }
+    *remaining -= hit.t;
+    ray.o = offset_origin(p, n, ray.d);
+    true
 }
 
 /// [`shadow_transmittance`] in a scene where every surface blocks shadow rays
