@@ -34,13 +34,16 @@ use super::walk::{
 use crate::bsdf::{flags, BsdfContext};
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::color::Spectrum;
+use crate::emitter::Emitter;
 use crate::interaction::offset_origin;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
+use crate::math::INV_FOUR_PI;
 use crate::math::{mis_weight, Ray};
 use crate::math::{Vec2, Vec3};
 use crate::medium::Homogeneous;
 use crate::sampler::Sampler;
 use crate::scene::world::{Scene, SceneEmitter};
+use crate::shape::mesh::MeshPlane;
 use crate::shape::Geometry;
 use crate::texture::Texture;
 
@@ -85,22 +88,64 @@ pub fn skip_sample_emitter(scene: &Scene, p: Vec3, sampler: &mut Sampler) {
 
 /// True when `Scene::sample_emitter_direction(p, None, u, false)` certainly returns a usable
 /// sample (`pdf > 0` and a finite, non-zero weight); false when that is not sure (the caller then
-/// samples; which emitters qualify is decided at build, `constant_sphere_lights`). Certain, with
-/// margins far above `f32` rounding, for the emitter `u.x` selects being an
-/// `area` emitter of constant, finite radiance (some channel ≥ 1e-10) on a sphere with outward
-/// normals, seen from a point `p`
-/// - outside it by 1 % of `r²` (`Sphere::sample_direction` samples the subtended cone),
-/// - with the cone sample `u.y` away from the rim: `1 − u.y > 10⁻³`, so the direction hits the
-///   sphere with |cos| ≥ ~0.03 at the hit (the one-sided emitter's front faces it), and
-///   `(1 − u.y) r² > 2·10⁻⁵ |c − p|²`, so `cos θ − cos α = (1 − u.y)(1 − cos α) > 10⁻⁵` (the cone
-///   pdf is positive and finite, as `1 − cos α ≥ r² / 2|c − p|²`).
+/// samples). Certain, with margins far above `f32` rounding, for the emitter `u.x` selects being
+/// - an `area` emitter of constant, finite radiance (some channel ≥ 1e-10) on a sphere with outward
+///   normals (decided at build, `constant_sphere_lights`), seen from a point `p`
+///   - outside it by 1 % of `r²` (`Sphere::sample_direction` samples the subtended cone),
+///   - with the cone sample `u.y` away from the rim: `1 − u.y > 10⁻³`, so the direction hits the
+///     sphere with |cos| ≥ ~0.03 at the hit (the one-sided emitter's front faces it), and
+///     `(1 − u.y) r² > 2·10⁻⁵ |c − p|²`, so `cos θ − cos α = (1 − u.y)(1 − cos α) > 10⁻⁵` (the cone
+///     pdf is positive and finite, as `1 − cos α ≥ r² / 2|c − p|²`);
+/// - a `constant` environment (a uniform direction of density 1/4π, weight `radiance · 4π · n`);
+/// - an `area` emitter of constant radiance on a flat mesh ([`MeshPlane`]), seen from a point in
+///   front of it, whatever point area sampling picks ([`surely_usable_plane`]).
 #[inline]
 fn surely_usable(scene: &Scene, p: Vec3, u: Vec2) -> bool {
     let Some((index, _)) = scene.select_emitter(u) else { return false };
-    let Some((center, r2)) = scene.constant_sphere_lights[index] else { return false };
-    let dist2 = (center - p).length_squared();
-    let rim = 1.0 - u.y;
-    dist2 > r2 * 1.01 && rim > 1e-3 && rim * r2 > 2e-5 * dist2
+    if let Some((center, r2)) = scene.constant_sphere_lights[index] {
+        let dist2 = (center - p).length_squared();
+        let rim = 1.0 - u.y;
+        return dist2 > r2 * 1.01 && rim > 1e-3 && rim * r2 > 2e-5 * dist2;
+    }
+    let n = scene.emitters.len() as f64;
+    match &scene.emitters[index] {
+        SceneEmitter::Other(Emitter::Constant(c)) => {
+            usable_weight(c.radiance, f64::from(INV_FOUR_PI) / n, f64::from(INV_FOUR_PI) / n)
+        }
+        SceneEmitter::Area { shape, radiance: Texture::Const(le) } => match &scene.shapes[*shape as usize].geometry {
+            Geometry::Mesh(m) => m.plane.is_some_and(|plane| surely_usable_plane(m, &plane, *le, p, n)),
+            _ => false,
+        },
+        _ => false,
+    }
+}
+
+/// [`surely_usable`] for a flat emitting mesh seen from `p` at height `h = n · p − c` in front of
+/// its one-sided emission, `h > 10⁻⁴ · (scale + |p|)` and `h > 10⁻⁴ · D`, where `D` bounds the
+/// distance to any point of the mesh (its bounding sphere): the sampled point lies in the plane up
+/// to ~10⁻⁶ of that scale and each triangle's normal within 10⁻⁵ of the plane's, so the direction
+/// to it leaves the emitter's front (`d · n < 0`) with `|cos| ≥ h / 2D`, and the solid-angle pdf
+/// `dist² / (|cos| A)` lies in `[h² / 2A, 2 D³ / (h A)]` (`usable_weight` checks that range).
+#[inline]
+fn surely_usable_plane(m: &crate::shape::mesh::Mesh, plane: &MeshPlane, le: Spectrum, p: Vec3, n: f64) -> bool {
+    let h = plane.n.dot(p) - plane.c;
+    let d_max = (p - plane.center).length() + plane.radius;
+    let s = plane.scale + p.abs().max_element();
+    if !(h > 1e-4 * s && h > 1e-4 * d_max) {
+        return false;
+    }
+    let (h, d_max) = (f64::from(h), f64::from(d_max) * 1.01);
+    let pdf_area = f64::from(1.0 / m.surface_area());
+    usable_weight(le, 0.5 * pdf_area * h * h / n, 2.0 * pdf_area * d_max * d_max * d_max / h / n)
+}
+
+/// Whether an emitter sample of radiance `le`, selected among `n` emitters with a density
+/// (selection included) certainly within `[pdf_lo, pdf_hi]`, has a density above 0 and a finite,
+/// non-zero weight `le / pdf` in `f32` (with wide margins: `[1e-30, 1e30]`).
+#[inline]
+fn usable_weight(le: Spectrum, pdf_lo: f64, pdf_hi: f64) -> bool {
+    let le_max = f64::from(le.abs().max_element());
+    crate::color::is_finite(le) && pdf_lo > 1e-30 && pdf_hi < 1e30 && le_max / pdf_hi > 1e-30 && le_max / pdf_lo < 1e30
 }
 
 /// Per emitter, decided at scene build for [`surely_usable`]: the centre and `r²` of an `area`
@@ -138,47 +183,74 @@ pub fn shadow_transmittance(
     }
     let mut tr = Spectrum::ONE;
     let mut remaining = ray.tmax;
-    for _ in 0..MAX_SEGMENTS {
-        if !(remaining > 0.0) {
-            break;
-        }
-        let m = medium.map(|m| &scene.media[m as usize]);
-        let t = m.map_or(f32::INFINITY, |m| m.sample_distance(sampler.next_1d(), channel));
-        // Up to and including `t`: a surface exactly at `t` is crossed, as with `t < seg` below.
-        ray.tmax = if t < remaining { t.next_up() } else { remaining };
-        stats.rays += 1;
-        // The hit alone (`Scene::ray_intersect`'s query); the crossing below builds what it needs of it.
-        let hit = scene.accel.intersect_inline(&scene.shapes, &ray);
-        let seg = hit.as_ref().map_or(remaining, |h| h.t);
-        if let Some(m) = m {
-            if t < seg {
-                // A real collision: homogeneous media have no null density, the estimate is 0.
-                return Spectrum::ZERO;
-            }
-            if seg.is_finite() {
-                let t_seg = m.transmittance(seg);
-                let p = t_seg[channel];
-                if !(p > 0.0) {
-                    return Spectrum::ZERO;
-                }
-                tr *= t_seg / p;
+    // The first segment is written out before the loop: most walks end in it, and the loop's
+    // set-up (the scene's fields it keeps at hand) is then paid only by walks of two or more.
+    if shadow_segment(scene, &mut ray, &mut medium, &mut remaining, &mut tr, channel, sampler, stats) {
+        for _ in 1..MAX_SEGMENTS {
+            if !shadow_segment(scene, &mut ray, &mut medium, &mut remaining, &mut tr, channel, sampler, stats) {
+                break;
             }
         }
-        let Some(hit) = hit else { break };
-        let (p, n, null_transmission) = shadow_crossing(scene, &hit, &ray);
-        tr *= null_transmission;
-        if tr == Spectrum::ZERO {
-            break;
-        }
-        // `is_medium_transition` and `target_medium` on the crossing's shape and normal.
-        let s = &scene.shapes[hit.shape as usize];
-        if s.interior.is_some() || s.exterior.is_some() {
-            medium = if ray.d.dot(n) > 0.0 { s.exterior } else { s.interior };
-        }
-        remaining -= hit.t;
-        ray.o = offset_origin(p, n, ray.d);
     }
     tr
+}
+
+/// One segment of [`shadow_transmittance`]'s walk: the distance sample, the trace up to it, the
+/// segment's transmittance into `tr` and the crossing of the surface that ends it. Returns whether
+/// the walk goes on (`false`: it ended, with its value in `tr`).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn shadow_segment(
+    scene: &Scene,
+    ray: &mut Ray,
+    medium: &mut Option<u32>,
+    remaining: &mut f32,
+    tr: &mut Spectrum,
+    channel: usize,
+    sampler: &mut Sampler,
+    stats: &mut LocalStats,
+) -> bool {
+    if !(*remaining > 0.0) {
+        return false;
+    }
+    let m = medium.map(|m| &scene.media[m as usize]);
+    let t = m.map_or(f32::INFINITY, |m| m.sample_distance(sampler.next_1d(), channel));
+    // Up to and including `t`: a surface exactly at `t` is crossed, as with `t < seg` below.
+    ray.tmax = if t < *remaining { t.next_up() } else { *remaining };
+    stats.rays += 1;
+    // The hit alone (`Scene::ray_intersect`'s query); the crossing below builds what it needs of it.
+    let hit = scene.accel.intersect_inline(&scene.shapes, ray);
+    let seg = hit.as_ref().map_or(*remaining, |h| h.t);
+    if let Some(m) = m {
+        if t < seg {
+            // A real collision: homogeneous media have no null density, the estimate is 0.
+            *tr = Spectrum::ZERO;
+            return false;
+        }
+        if seg.is_finite() {
+            let t_seg = m.transmittance(seg);
+            let p = t_seg[channel];
+            if !(p > 0.0) {
+                *tr = Spectrum::ZERO;
+                return false;
+            }
+            *tr *= t_seg / p;
+        }
+    }
+    let Some(hit) = hit else { return false };
+    let (p, n, null_transmission) = shadow_crossing(scene, &hit, ray);
+    *tr *= null_transmission;
+    if *tr == Spectrum::ZERO {
+        return false;
+    }
+    // `is_medium_transition` and `target_medium` on the crossing's shape and normal.
+    let s = &scene.shapes[hit.shape as usize];
+    if s.interior.is_some() || s.exterior.is_some() {
+        *medium = if ray.d.dot(n) > 0.0 { s.exterior } else { s.interior };
+    }
+    *remaining -= hit.t;
+    ray.o = offset_origin(p, n, ray.d);
+    true
 }
 
 /// [`shadow_transmittance`] in a scene where every surface blocks shadow rays
@@ -703,4 +775,62 @@ fn trace_from<W: PathWeight, T: Tally, const TRACED: bool>(
         si = None;
     }
     (result, valid_ray)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::build::build_scene;
+    use crate::scene::xml::parse_file;
+    use std::path::Path;
+
+    /// `skip_sample_emitter` decided without sampling (`surely_usable`: here a constant environment
+    /// and a rectangle light) draws exactly what the emitter sample would make it draw, at points
+    /// inside the glass sphere, around the light's plane (both sides, down to 1e-6 from it) and far away.
+    #[test]
+    fn skip_decides_as_the_emitter_sample_does_for_flat_lights_and_environments() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+        let parsed = parse_file(&root.join("scenes/media_rough_glass.xml"), &[]).expect("parse");
+        let scene = build_scene(&parsed).expect("build");
+        let plane = scene
+            .shapes
+            .iter()
+            .find_map(|s| match (&s.geometry, s.emitter) {
+                (Geometry::Mesh(m), Some(_)) => m.plane,
+                _ => None,
+            })
+            .expect("the rectangle light is flat");
+        let mut points = Sampler::new(13, 0);
+        let (mut usable, mut unusable, mut surely) = (0, 0, 0);
+        for i in 0..100_000u64 {
+            let u = Vec3::new(points.next_1d(), points.next_1d(), points.next_1d());
+            let p = match i % 4 {
+                0 => Vec3::new(0.0, 0.65, 0.0) + (u * 2.0 - Vec3::ONE) * 0.6,
+                1 => plane.center + (u * 2.0 - Vec3::ONE) * 3.0,
+                2 => {
+                    let h = (points.next_1d() - 0.5) * 10f32.powf(-6.0 * points.next_1d());
+                    plane.center + (u * 2.0 - Vec3::ONE) * plane.radius * 2.0 + plane.n * h
+                }
+                _ => (u * 2.0 - Vec3::ONE) * 1e6,
+            };
+            let mut skip = Sampler::new(17, i);
+            let mut full = skip.clone();
+            let sure = surely_usable(&scene, p, full.clone().next_2d());
+            skip_sample_emitter(&scene, p, &mut skip);
+            let (ds, emitted) = scene.sample_emitter_direction(p, None, full.next_2d(), false);
+            if ds.pdf != 0.0 && emitted != Spectrum::ZERO {
+                let _ = full.next_1d();
+                usable += 1;
+                surely += sure as u32;
+            } else {
+                unusable += 1;
+                assert!(!sure, "an unusable sample decided usable at {p} ({i})");
+            }
+            assert_eq!(skip.next_1d(), full.next_1d(), "sample streams diverge at {p} ({i})");
+        }
+        // Both outcomes occur (behind the one-sided light no sample is usable), and most usable
+        // samples are decided without sampling.
+        assert!(usable > 1000 && unusable > 1000, "{usable} usable, {unusable} not");
+        assert!(surely > usable / 2, "{surely} of {usable} decided without sampling");
+    }
 }

@@ -68,6 +68,24 @@ pub struct Mesh {
     /// emitter reads a spatially varying texture; `interaction` then leaves uv zero instead of
     /// interpolating it.
     pub hit_uv: bool,
+    /// The plane of a flat mesh (meshes up to [`MAX_SAMPLE_TRIANGLES`]; `None` otherwise), which
+    /// the volume integrators' emitter-skip test reads (`volpath::surely_usable`).
+    pub plane: Option<MeshPlane>,
+}
+
+/// The plane a flat mesh lies in (`rectangle`, a flat-shaded quad): every face normal within
+/// `1e-5` of `n` and every vertex within `1e-6 · scale` of the plane `n · x = c`.
+#[derive(Clone, Copy, Debug)]
+pub struct MeshPlane {
+    /// The unit normal as area sampling returns it (flipped with `flip_normals`).
+    pub n: Vec3,
+    pub c: f32,
+    /// A sphere around the vertices: every sampled point lies within `radius` of `center` (up to
+    /// rounding).
+    pub center: Vec3,
+    pub radius: f32,
+    /// 1 + the largest vertex coordinate magnitude (the scale of the rounding in sampled points).
+    pub scale: f32,
 }
 
 impl Mesh {
@@ -120,8 +138,10 @@ impl Mesh {
             sample_triangles: Vec::new(),
             area_distr,
             hit_uv: true,
+            plane: None,
         };
         mesh.face_frames = mesh.flat_frames();
+        mesh.plane = mesh.flat_plane();
         if mesh.indices.len() <= MAX_SAMPLE_TRIANGLES {
             mesh.sample_triangles = (0..mesh.indices.len() as u32).map(|prim| mesh.sample_triangle(prim)).collect();
         }
@@ -192,6 +212,28 @@ impl Mesh {
                 shading_frame_a(self.shading_normal(self.indices[prim as usize], n.into(), 1.0, 0.0, 0.0), dp_du.into())
             })
             .collect()
+    }
+
+    /// [`Mesh::plane`]: `None` for a mesh that is large, not flat, or has a degenerate triangle.
+    fn flat_plane(&self) -> Option<MeshPlane> {
+        if self.indices.len() > MAX_SAMPLE_TRIANGLES {
+            return None;
+        }
+        let n0 = *self.face_normals.first()?;
+        if !(n0.length_squared() > 0.5) || self.face_normals.iter().any(|n| !((*n - n0).length() <= 1e-5)) {
+            return None;
+        }
+        let n = if self.flip_normals { -n0 } else { n0 };
+        let vertices = || self.indices.iter().flatten().map(|&i| self.positions[i as usize]);
+        let c = n.dot(vertices().next()?);
+        let scale = 1.0 + vertices().map(|p| p.abs().max_element()).fold(0.0, f32::max);
+        if !scale.is_finite() || vertices().any(|p| !((n.dot(p) - c).abs() <= 1e-6 * scale)) {
+            return None;
+        }
+        let (lo, hi) = vertices().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        let center = (lo + hi) * 0.5;
+        let radius = vertices().map(|p| (p - center).length()).fold(0.0, f32::max);
+        Some(MeshPlane { n, c, center, radius, scale })
     }
 
     pub fn surface_area(&self) -> f32 {
