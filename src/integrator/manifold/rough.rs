@@ -75,11 +75,14 @@ fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
         return None;
     }
     let mut planes: Vec<RoughPlane> = Vec::new();
+    let mut reflect_below = f64::INFINITY;
     let mut enclosed = false;
     let mut curved = false;
     for s in scene.shapes.iter().filter(|s| s.interior == Some(medium) && s.exterior.is_none()) {
         match &scene.bsdfs[s.bsdf as usize] {
-            Bsdf::RoughDielectric(r) if r.alpha_u == r.alpha_v => {}
+            Bsdf::RoughDielectric(r) if r.alpha_u == r.alpha_v => {
+                reflect_below = reflect_below.min(super::rough_rate::reflect_below(r.eta));
+            }
             Bsdf::RoughDielectric(_) | Bsdf::Dielectric(_) => return None,
             _ => continue,
         }
@@ -112,9 +115,9 @@ fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
     }
     let q = super::rough_rate::rate(scene, medium);
     if curved {
-        return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true, q });
+        return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true, q, reflect_below });
     }
-    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false, q })
+    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false, q, reflect_below })
 }
 
 /// The rough boundary of `medium` (built with `connection = complete`).

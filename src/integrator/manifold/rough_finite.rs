@@ -181,6 +181,10 @@ pub fn point_reference_gated(
     }
     match plane {
         Some(plane) => {
+            // A sample that reflects in any frame: no refinement (the connection returns none).
+            if u_rate.is_some_and(|u| super::rough_rate::reflects(scene, medium, u, 1.0)) {
+                return Some(None);
+            }
             let reference = Reference::of_plane(plane);
             let eta = eta_of(&scene.bsdfs[plane.bsdf as usize]);
             let mut omega = omega_0;
@@ -202,6 +206,10 @@ pub fn point_reference_gated(
             }
             let q = super::rough_rate::depth_rate(scene, medium, si.t);
             if u_rate.is_some_and(|u| u as f64 >= q) {
+                return Some(None);
+            }
+            // A sample that reflects in any frame: no refinement (the connection returns none).
+            if u_rate.is_some_and(|u| super::rough_rate::reflects(scene, medium, u, q)) {
                 return Some(None);
             }
             for _ in 0..REFINE_STEPS {

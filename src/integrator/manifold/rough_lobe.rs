@@ -87,6 +87,11 @@ pub fn curved_reference_gated(
     if u_rate.is_some_and(|u| u as f64 >= q) {
         return Some(None);
     }
+    // A sample that reflects in any frame (`rough_rate::reflects`): the connection returns none
+    // whatever the refinement finds.
+    if u_rate.is_some_and(|u| super::rough_rate::reflects(scene, medium, u, q)) {
+        return Some(None);
+    }
     let of = |si: &SurfaceInteraction| Reference { q, ..Reference::of_point(scene, si) };
     let mut si = si0;
     for _ in 0..REFINE_STEPS {
