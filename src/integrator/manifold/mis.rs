@@ -178,6 +178,34 @@ pub fn snee_solid_angle_pdf(
     }
 }
 
+/// [`snee_solid_angle_pdf`] of a suffix whose `snee::pdf_snee` the caller already has (SNEE's
+/// sample, which computed it for the same suffix and light, positive, with `x_k` visible from
+/// `x_i`): the same vertex tests and conversion, without recomputing it.
+#[allow(clippy::too_many_arguments)]
+pub fn snee_solid_angle_pdf_known(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    pdf_snee: f64,
+    channel: usize,
+    cos_k: f64,
+    d_jk: f32,
+) -> f64 {
+    let Some(x_i) = x_i.filter(|x| opts.technique != SneeTechnique::Forward && x.medium == x_j.medium) else {
+        return 0.0;
+    };
+    if super::tables(scene).is_none() || !(pdf_snee > 0.0) {
+        return 0.0;
+    }
+    let to_sa = p_volume(scene, x_i, x_j.p, channel) * cos_k / (d_jk as f64 * d_jk as f64);
+    if to_sa > 0.0 {
+        pdf_snee / to_sa
+    } else {
+        0.0
+    }
+}
+
 /// Which technique made the suffix.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EnvTechnique {

@@ -67,6 +67,10 @@ pub struct RoughBoundary {
     /// The rate `q` at which the connection runs at a medium vertex (`rough_rate::rate`,
     /// docs/manifold.md §7.2 "Rate").
     pub q: f64,
+    /// A lower bound of the Fresnel reflectance of every `roughdielectric` of the boundary at any
+    /// angle (`rough_rate::reflect_below`): an inner-direction sample whose `u1` lies below it is a
+    /// reflection (a failed sample) in any reference frame.
+    pub reflect_below: f64,
 }
 
 impl RoughBoundary {

@@ -55,9 +55,9 @@ use crate::shape::Geometry;
 
 pub use super::planes::{RoughBoundary, RoughPlane};
 pub use super::rough_lobe::{
-    curved_reference, pdf_inner, pdf_inner_in, pdf_inner_mixture, pdf_inner_ref, rough_pdfs, rough_weight,
-    sample_inner, sample_inner_in, sample_inner_mixture, sample_inner_ref, Reference, RoughPdfs, RoughPending,
-    RoughTechnique,
+    curved_reference, pdf_inner, pdf_inner_in, pdf_inner_mixture, pdf_inner_ref, rough_pdfs, rough_pdfs_known,
+    rough_weight, sample_inner, sample_inner_in, sample_inner_mixture, sample_inner_ref, Known, Reference, RoughPdfs,
+    RoughPending, RoughTechnique,
 };
 use super::rough_lobe::{on_boundary, on_plane, trace_inner};
 
@@ -75,11 +75,14 @@ fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
         return None;
     }
     let mut planes: Vec<RoughPlane> = Vec::new();
+    let mut reflect_below = f64::INFINITY;
     let mut enclosed = false;
     let mut curved = false;
     for s in scene.shapes.iter().filter(|s| s.interior == Some(medium) && s.exterior.is_none()) {
         match &scene.bsdfs[s.bsdf as usize] {
-            Bsdf::RoughDielectric(r) if r.alpha_u == r.alpha_v => {}
+            Bsdf::RoughDielectric(r) if r.alpha_u == r.alpha_v => {
+                reflect_below = reflect_below.min(super::rough_rate::reflect_below(r.eta));
+            }
             Bsdf::RoughDielectric(_) | Bsdf::Dielectric(_) => return None,
             _ => continue,
         }
@@ -112,9 +115,9 @@ fn rough_boundary(scene: &Scene, medium: u32) -> Option<RoughBoundary> {
     }
     let q = super::rough_rate::rate(scene, medium);
     if curved {
-        return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true, q });
+        return enclosed.then_some(RoughBoundary { planes: Vec::new(), curved: true, q, reflect_below });
     }
-    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false, q })
+    (enclosed && !planes.is_empty()).then_some(RoughBoundary { planes, curved: false, q, reflect_below })
 }
 
 /// The rough boundary of `medium` (built with `connection = complete`).
@@ -160,6 +163,8 @@ struct RoughConnection {
     omega_jk: Vec3,
     /// `f_p · T · f_s · tr_light` (without the light's `E / p_sel` and the density).
     f: Spectrum,
+    /// Forward BSDF sampling's density of `omega_l` at `x_k` (`eval_pdf` with `f_s`).
+    p_bsdf: f32,
 }
 
 /// Sample `omega_jk` in `reference` ([`sample_inner_in`]), find `x_k` (the first hit from `x_j`
@@ -189,10 +194,10 @@ fn connect(
     }
     stats.manifold_solutions += 1;
     let si_kj = with_wi(&si_k, -omega_jk);
-    let f_s = scene.bsdf(&si_k).eval(&BsdfContext::default(), &si_kj, si_k.to_local(omega_l));
+    let (f_s, p_bsdf) = scene.bsdf(&si_k).eval_pdf(&BsdfContext::default(), &si_kj, si_k.to_local(omega_l));
     let m = &scene.media[x_j.medium as usize];
     let f = m.phase.eval(x_j.wi, omega_jk) * m.transmittance(si_k.t) * f_s * tr;
-    Some(RoughConnection { si_k, omega_jk, f })
+    Some(RoughConnection { si_k, omega_jk, f, p_bsdf })
 }
 
 /// The manifold stage at a real scatter `v` inside the rough boundary `rb`: one emitter sample and,
@@ -267,7 +272,9 @@ pub fn sample(
         let u1 = super::rough_rate::rescale(u1, reference.q);
         let Some(c) = connect(scene, &x_j, &reference, plane, ds.d, u1, u2, stats) else { continue };
         let path = (&c.si_k, c.omega_jk, c.si_k.t);
-        let p = rough_pdfs(scene, opts, x_i, &x_j, path, Some(&reference), &light, channel, true, stats);
+        let known = Known { bsdf: Some(c.p_bsdf), pdf_snee: None };
+        let r = Some(&reference);
+        let p = rough_pdfs_known(scene, opts, x_i, &x_j, path, r, &light, channel, true, known, stats);
         let w = rough_weight(opts, RoughTechnique::Manifold, p);
         if !(w > 0.0) || !(p.manifold > 0.0) {
             continue;
@@ -327,6 +334,19 @@ pub fn snee_weight(
     light: &LightSample,
     channel: usize,
 ) -> Option<f64> {
+    snee_weight_known(scene, technique, rb, s, light, channel, None)
+}
+
+/// [`snee_weight`] with SNEE's own `pdf_snee` of the suffix and light given (`None`: computed).
+pub fn snee_weight_known(
+    scene: &Scene,
+    technique: SneeTechnique,
+    rb: &RoughBoundary,
+    s: &SneeSuffix,
+    light: &LightSample,
+    channel: usize,
+    pdf_snee: Option<f64>,
+) -> Option<f64> {
     let area = light.dist.is_finite() && !light.delta;
     if !area && (light.dist.is_finite() || !(light.delta || scene.environment.is_some())) {
         return None;
@@ -336,7 +356,7 @@ pub fn snee_weight(
     let d_jk = v_jk.length();
     let plane = locate(scene, rb, si_k, s.x_i.medium, v_jk / d_jk)?;
     if area {
-        return super::rough_finite::snee_weight(scene, technique, plane.as_ref(), s, light, channel);
+        return super::rough_finite::snee_weight_known(scene, technique, plane.as_ref(), s, light, channel, pdf_snee);
     }
     let v_ij = s.x_j - s.x_i.p;
     let t_ij = v_ij.length();
@@ -350,7 +370,8 @@ pub fn snee_weight(
     // curved boundary's reference costs one, SNEE's sample has no statistics to count it in).
     let mut no_rays = LocalStats::default();
     let reference = reference_of(scene, plane.as_ref(), &x_j, light.omega_l, &mut no_rays);
-    let p = rough_pdfs(scene, opts, Some(&s.x_i), &x_j, path, reference.as_ref(), light, channel, false, &mut no_rays);
+    let (r, known) = (reference.as_ref(), Known { bsdf: None, pdf_snee });
+    let p = rough_pdfs_known(scene, opts, Some(&s.x_i), &x_j, path, r, light, channel, false, known, &mut no_rays);
     Some(rough_weight(opts, RoughTechnique::Snee, p))
 }
 

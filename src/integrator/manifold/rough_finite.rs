@@ -29,7 +29,7 @@
 //! ([`sample_plane`], [`nee_weight`], [`bsdf_hit_weight`], [`snee_weight`]).
 
 use super::planes::RoughPlane;
-use super::rough_lobe::{self, on_boundary, on_plane, Reference, RoughPdfs, RoughTechnique, REFINE_STEPS};
+use super::rough_lobe::{self, on_boundary, on_plane, Known, Reference, RoughPdfs, RoughTechnique, REFINE_STEPS};
 use super::MediumVertex;
 use crate::bsdf::fresnel::{fresnel, refract};
 use crate::bsdf::{Bsdf, BsdfContext};
@@ -181,6 +181,10 @@ pub fn point_reference_gated(
     }
     match plane {
         Some(plane) => {
+            // A sample that reflects in any frame: no refinement (the connection returns none).
+            if u_rate.is_some_and(|u| super::rough_rate::reflects(scene, medium, u, 1.0)) {
+                return Some(None);
+            }
             let reference = Reference::of_plane(plane);
             let eta = eta_of(&scene.bsdfs[plane.bsdf as usize]);
             let mut omega = omega_0;
@@ -202,6 +206,10 @@ pub fn point_reference_gated(
             }
             let q = super::rough_rate::depth_rate(scene, medium, si.t);
             if u_rate.is_some_and(|u| u as f64 >= q) {
+                return Some(None);
+            }
+            // A sample that reflects in any frame: no refinement (the connection returns none).
+            if u_rate.is_some_and(|u| super::rough_rate::reflects(scene, medium, u, q)) {
                 return Some(None);
             }
             for _ in 0..REFINE_STEPS {
@@ -265,7 +273,7 @@ pub fn light_record(scene: &Scene, si_k: &SurfaceInteraction, end: &LightEnd) ->
     LightSample::hit(d, end.y, dist, scene.pdf_emitter_direction(si_k.p, &ds))
 }
 
-/// The four densities of the suffix (`rough_lobe::rough_pdfs` with the connection's `p_man`).
+/// The four densities of the suffix (`rough_lobe::rough_pdfs_known` with the connection's `p_man`).
 #[allow(clippy::too_many_arguments)]
 fn pdfs(
     scene: &Scene,
@@ -277,9 +285,11 @@ fn pdfs(
     manifold: f64,
     channel: usize,
     check_support: bool,
+    known: Known,
     stats: &mut LocalStats,
 ) -> RoughPdfs {
-    let p = rough_lobe::rough_pdfs(scene, opts, x_i, x_j, path, None, light, channel, check_support, stats);
+    let p =
+        rough_lobe::rough_pdfs_known(scene, opts, x_i, x_j, path, None, light, channel, check_support, known, stats);
     RoughPdfs { manifold, ..p }
 }
 
@@ -355,10 +365,12 @@ pub fn connect(
     }
     stats.manifold_solutions += 1;
     let si_kj = with_wi(&si_k, -omega_jk);
-    let f_s = scene.bsdf(&si_k).eval(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l));
+    // The value and forward BSDF sampling's density of omega_l from one evaluation.
+    let (f_s, p_bsdf) = scene.bsdf(&si_k).eval_pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l));
     let m = &scene.media[x_j.medium as usize];
     let f = m.phase.eval(x_j.wi, omega_jk) * m.transmittance(si_k.t) * f_s * le * tr;
-    let p = pdfs(scene, opts, x_i, x_j, (&si_k, omega_jk, si_k.t), &light, p_man, channel, true, stats);
+    let known = Known { bsdf: Some(p_bsdf), pdf_snee: None };
+    let p = pdfs(scene, opts, x_i, x_j, (&si_k, omega_jk, si_k.t), &light, p_man, channel, true, known, stats);
     let weight = rough_lobe::rough_weight(opts, RoughTechnique::Manifold, p);
     let value = f * (weight / p_man) as f32;
     Some(FiniteRoughConnection { value, weight, si_k, omega_jk, end, light, pdfs: p })
@@ -381,7 +393,7 @@ pub fn nee_weight(
     let end = end_of_sample(scene, ds)?;
     let light = LightSample::sampled(ds);
     let p_man = density(scene, plane, x_j, omega_jk, si_k, &end, stats);
-    let p = pdfs(scene, opts, x_i, x_j, (si_k, omega_jk, d_jk), &light, p_man, channel, true, stats);
+    let p = pdfs(scene, opts, x_i, x_j, (si_k, omega_jk, d_jk), &light, p_man, channel, true, Known::default(), stats);
     Some(rough_lobe::rough_weight(opts, RoughTechnique::FwdNee, p) as f32)
 }
 
@@ -403,7 +415,8 @@ pub fn bsdf_hit_weight(
     let light = light_record(scene, si_k, &end);
     let p_man = density(scene, rp.plane.as_ref(), &rp.x_j, omega_jk, si_k, &end, stats);
     let x_i = rp.x_i.as_ref();
-    let p = pdfs(scene, opts, x_i, &rp.x_j, (si_k, omega_jk, d_jk), &light, p_man, channel, true, stats);
+    let known = Known::default();
+    let p = pdfs(scene, opts, x_i, &rp.x_j, (si_k, omega_jk, d_jk), &light, p_man, channel, true, known, stats);
     Some(rough_lobe::rough_weight(opts, RoughTechnique::FwdBsdf, p) as f32)
 }
 
@@ -418,6 +431,19 @@ pub fn snee_weight(
     s: &SneeSuffix,
     light: &LightSample,
     channel: usize,
+) -> Option<f64> {
+    snee_weight_known(scene, technique, plane, s, light, channel, None)
+}
+
+/// [`snee_weight`] with SNEE's own `pdf_snee` of the suffix and light given (`None`: computed).
+pub fn snee_weight_known(
+    scene: &Scene,
+    technique: SneeTechnique,
+    plane: Option<&RoughPlane>,
+    s: &SneeSuffix,
+    light: &LightSample,
+    channel: usize,
+    pdf_snee: Option<f64>,
 ) -> Option<f64> {
     let hit = super::finite::area_point_hit(scene, &s.si_k, light.omega_l)?;
     let end = end_of_hit(scene, &hit, light.p)?;
@@ -434,6 +460,7 @@ pub fn snee_weight(
     let mut no_rays = LocalStats::default();
     let p_man = density(scene, plane, &x_j, omega_jk, &s.si_k, &end, &mut no_rays);
     let path = (&s.si_k, omega_jk, d_jk);
-    let p = pdfs(scene, opts, Some(&s.x_i), &x_j, path, light, p_man, channel, false, &mut no_rays);
+    let known = Known { bsdf: None, pdf_snee };
+    let p = pdfs(scene, opts, Some(&s.x_i), &x_j, path, light, p_man, channel, false, known, &mut no_rays);
     Some(rough_lobe::rough_weight(opts, RoughTechnique::Snee, p))
 }

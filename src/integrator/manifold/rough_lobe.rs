@@ -87,6 +87,11 @@ pub fn curved_reference_gated(
     if u_rate.is_some_and(|u| u as f64 >= q) {
         return Some(None);
     }
+    // A sample that reflects in any frame (`rough_rate::reflects`): the connection returns none
+    // whatever the refinement finds.
+    if u_rate.is_some_and(|u| super::rough_rate::reflects(scene, medium, u, q)) {
+        return Some(None);
+    }
     let of = |si: &SurfaceInteraction| Reference { q, ..Reference::of_point(scene, si) };
     let mut si = si0;
     for _ in 0..REFINE_STEPS {
@@ -212,10 +217,25 @@ pub fn sample_inner_mixture(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, u1: f32, u
 
 /// Solid-angle density of [`sample_inner_mixture`]'s `omega_jk`.
 pub fn pdf_inner_mixture(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, omega_jk: Vec3) -> f64 {
-    let p = pdf_inner_in(bsdf, frame, omega_l, omega_jk);
-    let Some(wide) = widened(bsdf) else { return p };
+    let Some(wide) = widened(bsdf) else { return pdf_inner_in(bsdf, frame, omega_l, omega_jk) };
+    // `pdf_inner_in` of either component: the same tests, frame and directions for both.
+    let n = frame.n;
+    if !(n.dot(omega_l) > 0.0) || !(omega_jk.dot(n) > 0.0) {
+        return 0.0;
+    }
+    let si = frame_si(frame, omega_l);
+    let wo = si.to_local(-omega_jk);
+    let ctx = BsdfContext::new(TransportMode::Importance);
+    let pdf = |b: &Bsdf| {
+        let p = b.pdf(&ctx, &si, wo) as f64;
+        if p.is_finite() && p > 0.0 {
+            p
+        } else {
+            0.0
+        }
+    };
     let s = WIDE_SHARE as f64;
-    (1.0 - s) * p + s * pdf_inner_in(&wide, frame, omega_l, omega_jk)
+    (1.0 - s) * pdf(bsdf) + s * pdf(&wide)
 }
 
 /// The connection's inner-direction sample in `reference` towards the light along `omega_l`:
@@ -302,15 +322,44 @@ pub fn rough_pdfs(
     opts: SneeOptions,
     x_i: Option<&SneeVertex>,
     x_j: &MediumVertex,
-    (si_k, omega_jk, d_jk): (&SurfaceInteraction, Vec3, f32),
+    path: (&SurfaceInteraction, Vec3, f32),
     reference: Option<&Reference>,
     light: &LightSample,
     channel: usize,
     check_support: bool,
     stats: &mut LocalStats,
 ) -> RoughPdfs {
+    let known = Known::default();
+    rough_pdfs_known(scene, opts, x_i, x_j, path, reference, light, channel, check_support, known, stats)
+}
+
+/// Densities of one suffix that the caller has already computed, each the same function of the
+/// same inputs as [`rough_pdfs`] computes it (so passing them changes no bit): `None` computes it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Known {
+    /// `bsdf.pdf(ω_kj → ω_l)` at `x_k` in radiance mode, with `wi = −omega_jk` (the `.1` of the
+    /// `eval_pdf` whose `.0` is the connection's `f_s`).
+    pub bsdf: Option<f32>,
+    /// `snee::pdf_snee` of the suffix with this light (SNEE's own, from its sample).
+    pub pdf_snee: Option<f64>,
+}
+
+/// [`rough_pdfs`] with the densities in `known` taken as given.
+#[allow(clippy::too_many_arguments)]
+pub fn rough_pdfs_known(
+    scene: &Scene,
+    opts: SneeOptions,
+    x_i: Option<&SneeVertex>,
+    x_j: &MediumVertex,
+    (si_k, omega_jk, d_jk): (&SurfaceInteraction, Vec3, f32),
+    reference: Option<&Reference>,
+    light: &LightSample,
+    channel: usize,
+    check_support: bool,
+    known: Known,
+    stats: &mut LocalStats,
+) -> RoughPdfs {
     let m = &scene.media[x_j.medium as usize];
-    let bsdf = scene.bsdf(si_k);
     let st = m.sigma_t[channel] as f64;
     // Forward: phase sampling at x_j, a free flight that survives to x_k.
     let fwd = m.phase.eval(x_j.wi, omega_jk) as f64 * (-st * d_jk as f64).exp();
@@ -318,8 +367,11 @@ pub fn rough_pdfs(
     let fwd_bsdf = if light.delta {
         0.0
     } else {
-        let si_kj = with_wi(si_k, -omega_jk);
-        fwd * bsdf.pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l)) as f64
+        let p = known.bsdf.unwrap_or_else(|| {
+            let si_kj = with_wi(si_k, -omega_jk);
+            scene.bsdf(si_k).pdf(&BsdfContext::default(), &si_kj, si_k.to_local(light.omega_l))
+        });
+        fwd * p as f64
     };
     let manifold = match reference {
         Some(r) if !light.dist.is_finite() => {
@@ -330,19 +382,22 @@ pub fn rough_pdfs(
         _ => 0.0,
     };
     let cos_k = omega_jk.dot(si_k.n).abs() as f64;
-    let snee = super::mis::snee_solid_angle_pdf(
-        scene,
-        opts,
-        x_i,
-        x_j,
-        si_k,
-        light,
-        channel,
-        check_support,
-        cos_k,
-        d_jk,
-        stats,
-    );
+    let snee = match known.pdf_snee {
+        Some(pdf_snee) => super::mis::snee_solid_angle_pdf_known(scene, opts, x_i, x_j, pdf_snee, channel, cos_k, d_jk),
+        None => super::mis::snee_solid_angle_pdf(
+            scene,
+            opts,
+            x_i,
+            x_j,
+            si_k,
+            light,
+            channel,
+            check_support,
+            cos_k,
+            d_jk,
+            stats,
+        ),
+    };
     let finite = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
     RoughPdfs { manifold: finite(manifold), fwd_nee: finite(fwd_nee), fwd_bsdf: finite(fwd_bsdf), snee: finite(snee) }
 }

@@ -72,6 +72,31 @@ pub fn depth_rate(scene: &Scene, medium: u32, d_0: f32) -> f64 {
     (DEPTH_TAU - tau).exp().max(DEPTH_MIN_RATE)
 }
 
+/// A lower bound of the unpolarized Fresnel reflectance (`bsdf::fresnel::fresnel`) of a dielectric
+/// interface of relative index `eta` at every angle, from either side: its normal-incidence value
+/// `((eta − 1)/(eta + 1))²` (the minimum over angles; in f32 within 3.4e-6 of it relatively for
+/// `eta` from 1.05 to 2.4), less 0.1 %. Where the connection's `u1` (rescaled by the rate) lies
+/// below it, the rough dielectric's `sample` picks the reflection (`u1 <= F`) whatever the
+/// microfacet normal, so the sample fails in any reference frame: the connection stops before the
+/// reference's refinement rays with the result it would have had after them (none).
+pub fn reflect_below(eta: f32) -> f64 {
+    let e = eta as f64;
+    let f0 = ((e - 1.0) / (e + 1.0)).powi(2);
+    if f0.is_finite() {
+        f0 * (1.0 - 1e-3)
+    } else {
+        0.0
+    }
+}
+
+/// Does the connection's `u1` at a vertex of `medium` whose rate is `q` (depth factor included)
+/// sample a reflection whatever the reference ([`reflect_below`])?
+#[inline]
+pub fn reflects(scene: &Scene, medium: u32, u1: f32, q: f64) -> bool {
+    let below = super::rough::boundary_of(scene, medium).map_or(0.0, |rb| rb.reflect_below);
+    (rescale(u1, q) as f64) < below
+}
+
 /// `u / q` for a uniform `u < q` (uniform on [0, 1) again), kept below 1.
 #[inline]
 pub fn rescale(u: f32, q: f64) -> f32 {
