@@ -44,7 +44,9 @@ impl Diffuse {
         Ok(Diffuse { reflectance })
     }
 
-    #[inline]
+    /// Always inlined, so that `path`'s AVX2 loop (`path::li_avx2`) compiles the cosine warp and
+    /// the reflectance lookup with its own target features instead of calling a baseline copy.
+    #[inline(always)]
     pub fn sample(
         &self,
         ctx: &BsdfContext,

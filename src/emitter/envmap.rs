@@ -278,7 +278,7 @@ impl EnvironmentEmitter {
     /// [`EnvironmentEmitter::eval`] and, with `with_pdf`, [`EnvironmentEmitter::pdf_direction`]
     /// (else 0) of world direction `d`, mapping `d` to uv once (a ray that escapes after a
     /// non-delta scattering needs both). The same values as the two calls.
-    #[inline]
+    #[inline(always)]
     pub fn eval_pdf(&self, d: Vec3, with_pdf: bool) -> (Spectrum, f32) {
         let local = self.to_local.transform_vector3(d).normalize_or_zero();
         let uv = Self::direction_to_uv(local);

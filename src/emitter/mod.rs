@@ -112,7 +112,9 @@ impl Emitter {
 
     /// [`Emitter::eval_environment`] and, with `with_pdf`, [`Emitter::pdf_direction`] (else 0) of
     /// an escaping ray's direction `d` at once (the envmap maps `d` to its image only once).
-    #[inline]
+    /// Always inlined (with [`EnvironmentEmitter::eval_pdf`]), so that `path`'s AVX2 loop compiles the envmap
+    /// lookup with its own target features instead of calling a baseline copy.
+    #[inline(always)]
     pub fn eval_environment_pdf(&self, d: Vec3, with_pdf: bool) -> (Spectrum, f32) {
         match self {
             Emitter::Envmap(e) => e.eval_pdf(d, with_pdf),

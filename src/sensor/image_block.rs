@@ -11,6 +11,8 @@
 //! full image. Weights are computed from film coordinates, so a sample contributes identical
 //! weights whichever block it is put into.
 
+#[cfg(target_arch = "x86_64")]
+use super::rfilter::gaussian8_fma;
 use super::rfilter::{FilterKernel, RFilter};
 use glam::Vec2;
 
@@ -27,6 +29,12 @@ pub struct ImageBlock {
     channels: usize,
     filter: RFilter,
     kernel: FilterKernel,
+    /// Whether [`ImageBlock::put`] splats by [`ImageBlock::put_rgb_gaussian_avx2`]: three channels, a
+    /// Gaussian at most 8 pixels wide per axis, a CPU with AVX2 and FMA, and storage coordinates
+    /// exact in `f32` (decided in [`ImageBlock::reset`]).
+    rgb_gaussian_avx2: bool,
+    /// The storage's first and last pixel in film coordinates, `(x, y, x, y)` in `f32`.
+    clip: [f32; 4],
     /// Storage (interior plus border), row-major, `channels` values then the weight per pixel.
     data: Vec<f32>,
 }
@@ -42,6 +50,8 @@ impl ImageBlock {
             channels,
             filter,
             kernel: FilterKernel::for_splatting(&filter),
+            rgb_gaussian_avx2: false,
+            clip: [0.0; 4],
             data: Vec::new(),
         };
         block.reset(offset, size);
@@ -55,6 +65,15 @@ impl ImageBlock {
         let (w, h) = self.storage_size();
         self.data.clear();
         self.data.resize(w * h * (self.channels + 1), 0.0);
+        let (ox, oy) = self.storage_origin();
+        // Pixel indices up to 2^24 are exact in f32, so the fast path clips the footprint in f32.
+        let exact = |o: i64, n: usize| o.abs() < 1 << 24 && (o + n as i64).abs() < 1 << 24;
+        self.rgb_gaussian_avx2 = self.channels == 3
+            && matches!(self.kernel, FilterKernel::Gaussian { radius, .. } if radius <= 3.5)
+            && exact(ox, w)
+            && exact(oy, h)
+            && has_avx2_fma();
+        self.clip = [ox as f32, oy as f32, (ox + w as i64 - 1) as f32, (oy + h as i64 - 1) as f32];
     }
 
     /// Zero all pixels and weights.
@@ -93,8 +112,24 @@ impl ImageBlock {
 
     /// Splat a sample at film position `pos` (pixels) with `values` (one per channel).
     /// Samples with a non-finite position are ignored; contributions outside the storage are dropped.
+    #[inline]
     pub fn put(&mut self, pos: Vec2, values: &[f32]) {
         debug_assert_eq!(values.len(), self.channels, "ImageBlock::put: wrong number of values");
+        #[cfg(target_arch = "x86_64")]
+        if self.rgb_gaussian_avx2 {
+            if let Ok(rgb) = <&[f32; 3]>::try_from(values) {
+                // SAFETY: `rgb_gaussian_avx2` is set only where the CPU has AVX2 and FMA.
+                if unsafe { self.put_rgb_gaussian_avx2(pos, rgb) } {
+                    return;
+                }
+            }
+        }
+        self.put_general(pos, values);
+    }
+
+    /// [`ImageBlock::put`] for any filter and channel count.
+    #[inline(never)]
+    fn put_general(&mut self, pos: Vec2, values: &[f32]) {
         if !pos.is_finite() {
             return;
         }
@@ -171,6 +206,91 @@ impl ImageBlock {
                 }
             }
         }
+    }
+
+    /// [`ImageBlock::put`] for RGB and a Gaussian filter in AVX2: the footprint found and clipped
+    /// in one 4-lane vector, the taps of both axes in one 8-lane polynomial (two when an axis has
+    /// more than 4 taps), and two pixels per 8-lane multiply and add. Every tap, product and sum is
+    /// the one the general path computes (the same operations lane by lane), so the same bits.
+    /// Returns `false`, having done nothing, for another filter or a footprint wider than 8 pixels.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    fn put_rgb_gaussian_avx2(&mut self, pos: Vec2, rgb: &[f32; 3]) -> bool {
+        use std::arch::x86_64::*;
+        let FilterKernel::Gaussian { ref coeff, radius } = self.kernel else { return false };
+        // Lanes (x0, y0, x1, y1): pixels i with centre i + 0.5 within the radius of pos,
+        // ceil(p - 0.5 - r) ..= floor(p - 0.5 + r), clipped to the storage.
+        let p4 = _mm_setr_ps(pos.x, pos.y, pos.x, pos.y);
+        let ends = _mm_add_ps(_mm_sub_ps(p4, _mm_set1_ps(0.5)), _mm_setr_ps(-radius, -radius, radius, radius));
+        // A NaN position is ignored (an infinite one clips to an empty footprint).
+        let ordered = _mm_movemask_ps(_mm_cmpord_ps(ends, ends));
+        let ends = _mm_blend_ps::<0b1100>(_mm_ceil_ps(ends), _mm_floor_ps(ends));
+        // SAFETY: `clip` holds 4 floats.
+        let clip = unsafe { _mm_loadu_ps(self.clip.as_ptr()) };
+        let ends = _mm_blend_ps::<0b1100>(_mm_max_ps(ends, clip), _mm_min_ps(ends, clip));
+        // The footprint is empty unless x0 <= x1 and y0 <= y1.
+        if _mm_movemask_ps(_mm_cmple_ps(ends, _mm_movehl_ps(ends, ends))) & ordered & 3 != 3 {
+            return true;
+        }
+        // (x0 - storage x, y0 - storage y, count_x - 1, count_y - 1), exact integers in f32.
+        let offs = _mm_sub_ps(ends, _mm_blend_ps::<0b1100>(clip, _mm_movelh_ps(ends, ends)));
+        let offs = _mm_cvttps_epi32(offs);
+        let (ix, iy) = (_mm_cvtsi128_si32(offs) as usize, _mm_extract_epi32::<1>(offs) as usize);
+        let (count_x, count_y) = (_mm_extract_epi32::<2>(offs) as usize + 1, _mm_extract_epi32::<3>(offs) as usize + 1);
+        if count_x > 8 || count_y > 8 {
+            return false;
+        }
+        // Taps: the weight of pixel first + i is gaussian((first + i) + 0.5 - pos), as `eval_taps_xy`;
+        // x taps in taps[0..], y taps in taps[ty..].
+        let half = _mm256_set1_ps(0.5);
+        let eval = |first: __m256, lane: __m256, p: __m256| {
+            let d = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(first, lane), half), p);
+            _mm256_max_ps(gaussian8_fma(d, coeff), _mm256_setzero_ps())
+        };
+        let mut taps = [0.0f32; 16];
+        let x0 = _mm_shuffle_ps::<0b00_00_00_00>(ends, ends);
+        let y0 = _mm_shuffle_ps::<0b01_01_01_01>(ends, ends);
+        let (px, py) = (_mm_set1_ps(pos.x), _mm_set1_ps(pos.y));
+        let ty = if count_x <= 4 && count_y <= 4 {
+            let lane = _mm256_setr_ps(0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0, 3.0);
+            let t = eval(_mm256_set_m128(y0, x0), lane, _mm256_set_m128(py, px));
+            // SAFETY: `taps` holds 16 floats.
+            unsafe { _mm256_storeu_ps(taps.as_mut_ptr(), t) };
+            4
+        } else {
+            let lane = _mm256_setr_ps(0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0);
+            let tx = eval(_mm256_set_m128(x0, x0), lane, _mm256_set_m128(px, px));
+            let t_y = eval(_mm256_set_m128(y0, y0), lane, _mm256_set_m128(py, py));
+            // SAFETY: `taps` holds 16 floats.
+            unsafe {
+                _mm256_storeu_ps(taps.as_mut_ptr(), tx);
+                _mm256_storeu_ps(taps.as_mut_ptr().add(8), t_y);
+            }
+            8
+        };
+        let (w, _) = self.storage_size();
+        let row_stride = w * 4;
+        let first = (iy * w + ix) * 4;
+        if first + (count_y - 1) * row_stride + 4 * count_x > self.data.len() {
+            return true;
+        }
+        let v4 = _mm_setr_ps(rgb[0], rgb[1], rgb[2], 1.0);
+        let wy = &taps[ty..ty + count_y];
+        // SAFETY: AVX2 is enabled, and the footprint's rows lie inside `data` (checked above).
+        unsafe {
+            let base = self.data.as_mut_ptr().add(first);
+            match count_x {
+                1 => splat_rows_avx2::<1>(base, row_stride, v4, &taps, wy),
+                2 => splat_rows_avx2::<2>(base, row_stride, v4, &taps, wy),
+                3 => splat_rows_avx2::<3>(base, row_stride, v4, &taps, wy),
+                4 => splat_rows_avx2::<4>(base, row_stride, v4, &taps, wy),
+                5 => splat_rows_avx2::<5>(base, row_stride, v4, &taps, wy),
+                6 => splat_rows_avx2::<6>(base, row_stride, v4, &taps, wy),
+                7 => splat_rows_avx2::<7>(base, row_stride, v4, &taps, wy),
+                _ => splat_rows_avx2::<8>(base, row_stride, v4, &taps, wy),
+            }
+        }
+        true
     }
 
     /// `put` for footprints wider than [`MAX_CACHED_TAPS`]: weights evaluated per pixel.
@@ -271,6 +391,18 @@ fn accumulate<const N: usize>(data: &mut [f32], row_stride: usize, values: &[f32
             }
             px[N] += weight;
         }
+    }
+}
+
+/// Whether the CPU has AVX2 and FMA (for [`ImageBlock::put_rgb_gaussian_avx2`]).
+fn has_avx2_fma() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
     }
 }
 
@@ -400,6 +532,54 @@ fn accumulate_rows_avx<const N: usize>(data: &mut [f32], row_stride: usize, v: g
     }
 }
 
+/// The rows of [`ImageBlock::put_rgb_gaussian_avx2`], `N` pixels wide: row `j` (`rows` floats
+/// apart from `base`) gets `(r, g, b, 1) · (wx · wy[j])` added per pixel, two pixels per 8-lane
+/// vector and an odd last one in 4 lanes (the products and sums of [`accumulate_rows`]); rows
+/// with `wy[j] == 0` are skipped, as there.
+///
+/// Built into its AVX2 caller (the intrinsics compile to AVX there).
+///
+/// # Safety
+/// AVX must be available, and `base[j·rows..j·rows + 4·N]` must lie in one allocation for every
+/// `j < wy.len()`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn splat_rows_avx2<const N: usize>(
+    base: *mut f32,
+    rows: usize,
+    v4: std::arch::x86_64::__m128,
+    wx: &[f32; 16],
+    wy: &[f32],
+) {
+    use std::arch::x86_64::*;
+    // SAFETY (every intrinsic below): AVX is available (the caller's contract).
+    unsafe {
+        let v8 = _mm256_set_m128(v4, v4);
+        let last = _mm_set1_ps(wx[N - 1]);
+        for (j, &wy) in wy.iter().enumerate() {
+            if wy == 0.0 {
+                continue;
+            }
+            let wy8 = _mm256_set1_ps(wy);
+            // Row j's 4·N floats lie inside the allocation (the caller's contract); pair k covers
+            // floats 8k..8k + 8 <= 4·N, the odd last pixel 4·N - 4..4·N.
+            let row = base.add(j * rows);
+            for k in 0..N / 2 {
+                // The pair's x weights (w_2k ×4, w_2k+1 ×4), hoisted out of the row loop.
+                let wxk = _mm256_set_m128(_mm_set1_ps(wx[2 * k + 1]), _mm_set1_ps(wx[2 * k]));
+                let p = row.add(8 * k);
+                let add = _mm256_mul_ps(v8, _mm256_mul_ps(wxk, wy8));
+                _mm256_storeu_ps(p, _mm256_add_ps(_mm256_loadu_ps(p), add));
+            }
+            if N % 2 == 1 {
+                let p = row.add(4 * N - 4);
+                let add = _mm_mul_ps(v4, _mm_mul_ps(last, _mm256_castps256_ps128(wy8)));
+                _mm_storeu_ps(p, _mm_add_ps(_mm_loadu_ps(p), add));
+            }
+        }
+    }
+}
+
 /// [`accumulate`] for RGB + alpha: the four values as one 4-lane multiply-add, then the weight.
 #[inline]
 fn accumulate4(data: &mut [f32], row_stride: usize, values: &[f32], wxs: &[f32], wys: &[f32]) {
@@ -459,7 +639,9 @@ mod tests {
     #[test]
     fn put_equals_per_pixel_filter() {
         let mut rng = crate::sampler::Sampler::new(5, 0);
-        for filter in [RFilter::default(), RFilter::Gaussian { stddev: 0.4 }, RFilter::Tent { radius: 1.5 }] {
+        // Gaussians of 3–5, 5–7 and 7–9 taps per axis (the AVX2 path takes up to 8).
+        let gaussians = [0.4, 0.5, 0.8, 1.0].map(|stddev| RFilter::Gaussian { stddev });
+        for filter in gaussians.into_iter().chain([RFilter::Tent { radius: 1.5 }]) {
             for channels in [3, 4, 5, 7] {
                 let (offset, size) = ((3, -2), (9u32, 7u32));
                 let mut block = ImageBlock::new(offset, size, filter, channels);
@@ -470,6 +652,10 @@ mod tests {
                     let pos = Vec2::new(rng.next_1d() * 13.0, rng.next_1d() * 11.0 - 4.0);
                     let values: Vec<f32> = (0..channels).map(|_| rng.next_1d() * 4.0).collect();
                     block.put(pos, &values);
+                    // Non-finite positions add nothing.
+                    block.put(Vec2::new(f32::NAN, pos.y), &values);
+                    block.put(Vec2::new(pos.x, f32::INFINITY), &values);
+                    block.put(Vec2::new(f32::NEG_INFINITY, pos.y), &values);
                     for y in 0..h {
                         for x in 0..w {
                             let (fx, fy) = (x + offset.0 as i64 - border, y + offset.1 as i64 - border);

@@ -267,6 +267,29 @@ fn gaussian_taps_fma(first: i64, pos: f32, coeff: &[f32; 10], out: &mut [f32]) {
     }
 }
 
+/// The Gaussian's polynomial ([`estrin10`] with fused multiply-adds) in 8 lanes, not clamped:
+/// lane by lane the bits of [`estrin10_fma`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,fma")]
+#[inline]
+pub(crate) fn gaussian8_fma(x: std::arch::x86_64::__m256, c: &[f32; 10]) -> std::arch::x86_64::__m256 {
+    use std::arch::x86_64::*;
+    let k = |i: usize| _mm256_set1_ps(c[i]);
+    let x = _mm256_mul_ps(x, x);
+    let x2 = _mm256_mul_ps(x, x);
+    let x4 = _mm256_mul_ps(x2, x2);
+    let x8 = _mm256_mul_ps(x4, x4);
+    let a0 = _mm256_fmadd_ps(x, k(1), k(0));
+    let a1 = _mm256_fmadd_ps(x, k(3), k(2));
+    let a2 = _mm256_fmadd_ps(x, k(5), k(4));
+    let a3 = _mm256_fmadd_ps(x, k(7), k(6));
+    let a4 = _mm256_fmadd_ps(x, k(9), k(8));
+    let b0 = _mm256_fmadd_ps(x2, a1, a0);
+    let b1 = _mm256_fmadd_ps(x2, a3, a2);
+    let c0 = _mm256_fmadd_ps(x4, b1, b0);
+    _mm256_fmadd_ps(x8, a4, c0)
+}
+
 /// [`estrin10`] with the CPU's fused multiply-add (one rounding, exactly Dr.Jit's `fmadd`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "fma")]
