@@ -324,7 +324,7 @@ pub fn nee_weight(
 }
 
 /// SNEE's weight for a suffix it made through a rough boundary towards a directional light, the
-/// environment or an area light (`rough_finite::snee_weight`), or `None` (another light: SNEE's
+/// environment or an area light (`rough_finite::snee_weight_known`), or `None` (another light: SNEE's
 /// own weight stands).
 pub fn snee_weight(
     scene: &Scene,

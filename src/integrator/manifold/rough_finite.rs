@@ -423,19 +423,8 @@ pub fn bsdf_hit_weight(
 /// SNEE's weight for a suffix it made through a rough `x_k` (on `plane`) towards the point
 /// `light.p` of an area light; `None` when that point is not on an area light seen from `x_k`
 /// (SNEE's own weight stands). No rays are counted (SNEE's sample has no statistics here): one
-/// ray finds the light's shape, up to three the reference.
-pub fn snee_weight(
-    scene: &Scene,
-    technique: SneeTechnique,
-    plane: Option<&RoughPlane>,
-    s: &SneeSuffix,
-    light: &LightSample,
-    channel: usize,
-) -> Option<f64> {
-    snee_weight_known(scene, technique, plane, s, light, channel, None)
-}
-
-/// [`snee_weight`] with SNEE's own `pdf_snee` of the suffix and light given (`None`: computed).
+/// ray finds the light's shape, up to three the reference. `pdf_snee`: SNEE's own density of the
+/// suffix and light, when its caller has it (`None`: computed here).
 pub fn snee_weight_known(
     scene: &Scene,
     technique: SneeTechnique,
