@@ -93,7 +93,8 @@ pub fn reflect_below(eta: f32) -> f64 {
 /// sample a reflection whatever the reference ([`reflect_below`])?
 #[inline]
 pub fn reflects(scene: &Scene, medium: u32, u1: f32, q: f64) -> bool {
-    let below = super::rough::boundary_of(scene, medium).map_or(0.0, |rb| rb.reflect_below);
+    let boundary = super::tables(scene).and_then(|t| t.rough.get(medium as usize)?.as_ref());
+    let below = boundary.map_or(0.0, |rb| rb.reflect_below);
     (rescale(u1, q) as f64) < below
 }
 
