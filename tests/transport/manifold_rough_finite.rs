@@ -279,7 +279,7 @@ fn technique_weights_sum_to_one_on_sampled_suffixes() {
                 let w_bsdf = rough::emitter_hit_weight(&s, opts, &rp, Some(&hit), omega_l, 0, &mut stats)
                     .expect("shared") as f64;
                 let suffix = SneeSuffix { x_i, x_j: p_j, si_k: c.si_k };
-                let w_snee = rough::snee_weight(&s, opts.technique, rb, &suffix, &c.light, 0).expect("shared");
+                let w_snee = rough::snee_weight(&s, opts.technique, rb, &suffix, &c.light, 0, None).expect("shared");
                 let sum = c.weight + w_nee + w_bsdf + w_snee;
                 let cos_y = -c.end.n_y.dot(omega_l);
                 if cos_y > 0.1 {

@@ -170,6 +170,20 @@ pub fn snee_solid_angle_pdf(
     else {
         return 0.0;
     };
+    per_solid_angle(scene, x_i, x_j, pdf_snee, channel, cos_k, d_jk)
+}
+
+/// `pdf_snee` (SNEE's density of a suffix from `x_i`) divided by forward's volume density of `x_j`
+/// and by `dA(x_k)/dω_jk = d_jk²/cos_k` ([`snee_solid_angle_pdf`]); 0 where that factor is not positive.
+fn per_solid_angle(
+    scene: &Scene,
+    x_i: &SneeVertex,
+    x_j: &MediumVertex,
+    pdf_snee: f64,
+    channel: usize,
+    cos_k: f64,
+    d_jk: f32,
+) -> f64 {
     let to_sa = p_volume(scene, x_i, x_j.p, channel) * cos_k / (d_jk as f64 * d_jk as f64);
     if to_sa > 0.0 {
         pdf_snee / to_sa
@@ -198,12 +212,7 @@ pub fn snee_solid_angle_pdf_known(
     if super::tables(scene).is_none() || !(pdf_snee > 0.0) {
         return 0.0;
     }
-    let to_sa = p_volume(scene, x_i, x_j.p, channel) * cos_k / (d_jk as f64 * d_jk as f64);
-    if to_sa > 0.0 {
-        pdf_snee / to_sa
-    } else {
-        0.0
-    }
+    per_solid_angle(scene, x_i, x_j, pdf_snee, channel, cos_k, d_jk)
 }
 
 /// Which technique made the suffix.

@@ -447,7 +447,7 @@ pub fn snee_weight(
     }
     if let Some(rb) = rough::boundary_of(scene, s.x_i.medium) {
         // SNEE computed its own density of this suffix and light: passed, not recomputed.
-        return rough::snee_weight_known(scene, technique, rb, s, light, channel, Some(pdf_snee));
+        return rough::snee_weight(scene, technique, rb, s, light, channel, Some(pdf_snee));
     }
     if let Some(w) = curved_finite::snee_weight(scene, technique, s, light, channel) {
         return Some(w);

@@ -55,9 +55,9 @@ use crate::shape::Geometry;
 
 pub use super::planes::{RoughBoundary, RoughPlane};
 pub use super::rough_lobe::{
-    curved_reference, pdf_inner, pdf_inner_in, pdf_inner_mixture, pdf_inner_ref, rough_pdfs, rough_pdfs_known,
-    rough_weight, sample_inner, sample_inner_in, sample_inner_mixture, sample_inner_ref, Known, Reference, RoughPdfs,
-    RoughPending, RoughTechnique,
+    curved_reference, pdf_inner, pdf_inner_in, pdf_inner_mixture, pdf_inner_ref, rough_pdfs, rough_weight,
+    sample_inner, sample_inner_in, sample_inner_mixture, sample_inner_ref, Known, Reference, RoughPdfs, RoughPending,
+    RoughTechnique,
 };
 use super::rough_lobe::{on_boundary, on_plane, trace_inner};
 
@@ -274,7 +274,7 @@ pub fn sample(
         let path = (&c.si_k, c.omega_jk, c.si_k.t);
         let known = Known { bsdf: Some(c.p_bsdf), pdf_snee: None };
         let r = Some(&reference);
-        let p = rough_pdfs_known(scene, opts, x_i, &x_j, path, r, &light, channel, true, known, stats);
+        let p = rough_pdfs(scene, opts, x_i, &x_j, path, r, &light, channel, true, known, stats);
         let w = rough_weight(opts, RoughTechnique::Manifold, p);
         if !(w > 0.0) || !(p.manifold > 0.0) {
             continue;
@@ -319,26 +319,16 @@ pub fn nee_weight(
     let reference = reference_of(scene, plane.as_ref(), x_j, ds.d, stats);
     let light = LightSample::sampled(ds);
     let path = (si_k, omega_jk, d_jk);
-    let p = rough_pdfs(scene, opts, x_i, x_j, path, reference.as_ref(), &light, channel, true, stats);
+    let (r, known) = (reference.as_ref(), Known::default());
+    let p = rough_pdfs(scene, opts, x_i, x_j, path, r, &light, channel, true, known, stats);
     Some(rough_weight(opts, RoughTechnique::FwdNee, p) as f32)
 }
 
 /// SNEE's weight for a suffix it made through a rough boundary towards a directional light, the
-/// environment or an area light (`rough_finite::snee_weight_known`), or `None` (another light: SNEE's
-/// own weight stands).
+/// environment or an area light (`rough_finite::snee_weight`), or `None` (another light: SNEE's
+/// own weight stands). `pdf_snee`: SNEE's own density of the suffix and light, when the caller has
+/// it (`None`: computed here).
 pub fn snee_weight(
-    scene: &Scene,
-    technique: SneeTechnique,
-    rb: &RoughBoundary,
-    s: &SneeSuffix,
-    light: &LightSample,
-    channel: usize,
-) -> Option<f64> {
-    snee_weight_known(scene, technique, rb, s, light, channel, None)
-}
-
-/// [`snee_weight`] with SNEE's own `pdf_snee` of the suffix and light given (`None`: computed).
-pub fn snee_weight_known(
     scene: &Scene,
     technique: SneeTechnique,
     rb: &RoughBoundary,
@@ -356,7 +346,7 @@ pub fn snee_weight_known(
     let d_jk = v_jk.length();
     let plane = locate(scene, rb, si_k, s.x_i.medium, v_jk / d_jk)?;
     if area {
-        return super::rough_finite::snee_weight_known(scene, technique, plane.as_ref(), s, light, channel, pdf_snee);
+        return super::rough_finite::snee_weight(scene, technique, plane.as_ref(), s, light, channel, pdf_snee);
     }
     let v_ij = s.x_j - s.x_i.p;
     let t_ij = v_ij.length();
@@ -371,7 +361,7 @@ pub fn snee_weight_known(
     let mut no_rays = LocalStats::default();
     let reference = reference_of(scene, plane.as_ref(), &x_j, light.omega_l, &mut no_rays);
     let (r, known) = (reference.as_ref(), Known { bsdf: None, pdf_snee });
-    let p = rough_pdfs_known(scene, opts, Some(&s.x_i), &x_j, path, r, light, channel, false, known, &mut no_rays);
+    let p = rough_pdfs(scene, opts, Some(&s.x_i), &x_j, path, r, light, channel, false, known, &mut no_rays);
     Some(rough_weight(opts, RoughTechnique::Snee, p))
 }
 
@@ -424,7 +414,8 @@ pub fn bsdf_hit_weight(
     let path = (&rp.si_k, omega_jk, d_jk);
     let reference = reference_of(scene, rp.plane.as_ref(), &rp.x_j, omega_l, stats);
     let x_i = rp.x_i.as_ref();
-    let p = rough_pdfs(scene, opts, x_i, &rp.x_j, path, reference.as_ref(), &light, channel, true, stats);
+    let (r, known) = (reference.as_ref(), Known::default());
+    let p = rough_pdfs(scene, opts, x_i, &rp.x_j, path, r, &light, channel, true, known, stats);
     Some(rough_weight(opts, RoughTechnique::FwdBsdf, p) as f32)
 }
 

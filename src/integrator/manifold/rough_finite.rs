@@ -273,7 +273,7 @@ pub fn light_record(scene: &Scene, si_k: &SurfaceInteraction, end: &LightEnd) ->
     LightSample::hit(d, end.y, dist, scene.pdf_emitter_direction(si_k.p, &ds))
 }
 
-/// The four densities of the suffix (`rough_lobe::rough_pdfs_known` with the connection's `p_man`).
+/// The four densities of the suffix (`rough_lobe::rough_pdfs` with the connection's `p_man`).
 #[allow(clippy::too_many_arguments)]
 fn pdfs(
     scene: &Scene,
@@ -288,8 +288,7 @@ fn pdfs(
     known: Known,
     stats: &mut LocalStats,
 ) -> RoughPdfs {
-    let p =
-        rough_lobe::rough_pdfs_known(scene, opts, x_i, x_j, path, None, light, channel, check_support, known, stats);
+    let p = rough_lobe::rough_pdfs(scene, opts, x_i, x_j, path, None, light, channel, check_support, known, stats);
     RoughPdfs { manifold, ..p }
 }
 
@@ -425,7 +424,7 @@ pub fn bsdf_hit_weight(
 /// (SNEE's own weight stands). No rays are counted (SNEE's sample has no statistics here): one
 /// ray finds the light's shape, up to three the reference. `pdf_snee`: SNEE's own density of the
 /// suffix and light, when its caller has it (`None`: computed here).
-pub fn snee_weight_known(
+pub fn snee_weight(
     scene: &Scene,
     technique: SneeTechnique,
     plane: Option<&RoughPlane>,

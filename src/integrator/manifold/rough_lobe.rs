@@ -159,12 +159,24 @@ pub fn pdf_inner(bsdf: &Bsdf, n: Vec3, omega_l: Vec3, omega_jk: Vec3) -> f64 {
 
 /// [`pdf_inner`] in the shading frame `frame`: the density of [`sample_inner_in`].
 pub fn pdf_inner_in(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, omega_jk: Vec3) -> f64 {
+    inner_local(frame, omega_l, omega_jk).map_or(0.0, |(si, wo)| inner_pdf(bsdf, &si, wo))
+}
+
+/// The record and local direction in which [`pdf_inner_in`] evaluates a density in `frame`, or
+/// `None` where it is 0 (`omega_l` or `omega_jk` below the frame's normal).
+fn inner_local(frame: Frame, omega_l: Vec3, omega_jk: Vec3) -> Option<(SurfaceInteraction, Vec3)> {
     let n = frame.n;
     if !(n.dot(omega_l) > 0.0) || !(omega_jk.dot(n) > 0.0) {
-        return 0.0;
+        return None;
     }
     let si = frame_si(frame, omega_l);
-    let p = bsdf.pdf(&BsdfContext::new(TransportMode::Importance), &si, si.to_local(-omega_jk)) as f64;
+    let wo = si.to_local(-omega_jk);
+    Some((si, wo))
+}
+
+/// `bsdf`'s importance-mode density of `wo` at `si` ([`inner_local`]), 0 where not finite and positive.
+fn inner_pdf(bsdf: &Bsdf, si: &SurfaceInteraction, wo: Vec3) -> f64 {
+    let p = bsdf.pdf(&BsdfContext::new(TransportMode::Importance), si, wo) as f64;
     if p.is_finite() && p > 0.0 {
         p
     } else {
@@ -218,24 +230,10 @@ pub fn sample_inner_mixture(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, u1: f32, u
 /// Solid-angle density of [`sample_inner_mixture`]'s `omega_jk`.
 pub fn pdf_inner_mixture(bsdf: &Bsdf, frame: Frame, omega_l: Vec3, omega_jk: Vec3) -> f64 {
     let Some(wide) = widened(bsdf) else { return pdf_inner_in(bsdf, frame, omega_l, omega_jk) };
-    // `pdf_inner_in` of either component: the same tests, frame and directions for both.
-    let n = frame.n;
-    if !(n.dot(omega_l) > 0.0) || !(omega_jk.dot(n) > 0.0) {
-        return 0.0;
-    }
-    let si = frame_si(frame, omega_l);
-    let wo = si.to_local(-omega_jk);
-    let ctx = BsdfContext::new(TransportMode::Importance);
-    let pdf = |b: &Bsdf| {
-        let p = b.pdf(&ctx, &si, wo) as f64;
-        if p.is_finite() && p > 0.0 {
-            p
-        } else {
-            0.0
-        }
-    };
+    // `pdf_inner_in` of either component: the tests, frame and local direction built once for both.
+    let Some((si, wo)) = inner_local(frame, omega_l, omega_jk) else { return 0.0 };
     let s = WIDE_SHARE as f64;
-    (1.0 - s) * pdf(bsdf) + s * pdf(&wide)
+    (1.0 - s) * inner_pdf(bsdf, &si, wo) + s * inner_pdf(&wide, &si, wo)
 }
 
 /// The connection's inner-direction sample in `reference` towards the light along `omega_l`:
@@ -309,30 +307,6 @@ pub struct RoughPdfs {
     pub snee: f64,
 }
 
-/// The densities of the suffix `x_j → x_k → light` (plus `x_i` before, when it is the SNEE vertex
-/// just before `x_j`), with `omega_jk` the direction the path took from `x_j` and `d_jk` its
-/// length. The direction is passed rather than recomputed from the points: at small roughness the
-/// lobe is narrower than the error of `(x_k − x_j)/d` for a vertex `x_j` close to the surface.
-/// `check_support`: test that `x_k` is visible from `x_i` (SNEE's probe); the caller passes
-/// `false` when it knows. `reference`: the frame the connection samples this suffix in (`None`:
-/// the connection cannot make it, its density is 0). The light segment is the caller's business.
-#[allow(clippy::too_many_arguments)]
-pub fn rough_pdfs(
-    scene: &Scene,
-    opts: SneeOptions,
-    x_i: Option<&SneeVertex>,
-    x_j: &MediumVertex,
-    path: (&SurfaceInteraction, Vec3, f32),
-    reference: Option<&Reference>,
-    light: &LightSample,
-    channel: usize,
-    check_support: bool,
-    stats: &mut LocalStats,
-) -> RoughPdfs {
-    let known = Known::default();
-    rough_pdfs_known(scene, opts, x_i, x_j, path, reference, light, channel, check_support, known, stats)
-}
-
 /// Densities of one suffix that the caller has already computed, each the same function of the
 /// same inputs as [`rough_pdfs`] computes it (so passing them changes no bit): `None` computes it.
 #[derive(Clone, Copy, Debug, Default)]
@@ -344,9 +318,15 @@ pub struct Known {
     pub pdf_snee: Option<f64>,
 }
 
-/// [`rough_pdfs`] with the densities in `known` taken as given.
+/// The densities of the suffix `x_j → x_k → light` (plus `x_i` before, when it is the SNEE vertex
+/// just before `x_j`), with `omega_jk` the direction the path took from `x_j` and `d_jk` its
+/// length. The direction is passed rather than recomputed from the points: at small roughness the
+/// lobe is narrower than the error of `(x_k − x_j)/d` for a vertex `x_j` close to the surface.
+/// `check_support`: test that `x_k` is visible from `x_i` (SNEE's probe); the caller passes
+/// `false` when it knows. `reference`: the frame the connection samples this suffix in (`None`:
+/// the connection cannot make it, its density is 0). The light segment is the caller's business. `known`: the densities the caller already has, taken as given.
 #[allow(clippy::too_many_arguments)]
-pub fn rough_pdfs_known(
+pub fn rough_pdfs(
     scene: &Scene,
     opts: SneeOptions,
     x_i: Option<&SneeVertex>,
