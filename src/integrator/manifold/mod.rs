@@ -32,6 +32,7 @@
 //! `snee/sample.rs`). The flat boundaries are built at scene load into `volpath_snee`'s tables
 //! ([`Snee::flat`], read through [`tables`]).
 
+pub mod beam;
 pub mod chain;
 pub mod chain_seed;
 pub mod curved;
