@@ -57,7 +57,32 @@ fn mean_se(sum: f64, sq: f64, n: usize) -> (f64, f64) {
 
 #[test]
 fn one_reflection_beams_match_the_chain_from_a_sampled_medium_vertex() {
-    let scene = common::scene(&ball_scene(""), &[]);
+    let points = [Vec3::new(0.1, -0.2, 0.3), Vec3::new(-0.5, 0.1, -0.2), Vec3::new(0.2, 0.6, -0.1)];
+    beams_match_the_chain(&ball_scene(""), &points, 1 << 21, 1 << 18);
+}
+
+/// The same comparison through a smooth-shaded mesh (`scenes/meshes/pebble.ply`, a squashed
+/// icosphere of 320 triangles whose interpolated normals differ from the geometric ones): checks
+/// the adjoint shading-normal factor of the light subpath against the radiance-mode chain.
+/// Ignored: a measurement, not a check. On the mesh the chain's estimate is heavy-tailed (its
+/// Bernoulli counts are rare and large where basins are small), so a z-test against it at a fixed
+/// count is not reliable: the first run (2²⁰ subpaths, 2¹⁶ chain samples per vertex) read z 1.30,
+/// 9.87 (chain 0.000147 ± 0.000015 against beams 0.000291 ± 0.000001) and stopped there; with
+/// 2¹⁸ chain samples the same vertex read 0.000356 ± 0.000094 (z −0.69), the others z 1.72 and
+/// −0.01 (docs/beams.md). Without the shading-normal factor the beams read 1.5–4 % higher.
+#[test]
+#[ignore]
+fn one_reflection_beams_match_the_chain_through_a_smooth_shaded_mesh() {
+    let xml = ball_scene("").replace(
+        r#"<shape type="sphere"><float name="radius" value="1"/>"#,
+        r#"<shape type="ply"><string name="filename" value="meshes/pebble.ply"/>"#,
+    );
+    let points = [Vec3::new(0.1, -0.1, 0.2), Vec3::new(-0.4, 0.1, -0.2), Vec3::new(0.2, 0.2, -0.1)];
+    beams_match_the_chain(&xml, &points, 1 << 20, 1 << 18);
+}
+
+fn beams_match_the_chain(xml: &str, points: &[Vec3], n_beams: usize, n_chain: usize) {
+    let scene = common::scene(xml, &[]);
     let boundary = beam::beam_boundaries(&scene)[0].expect("beams apply to the glass ball");
     let (ds, _) = scene.sample_emitter_direction(Vec3::ZERO, None, snee::math::Vec2::splat(0.5), false);
     let omega_l = ds.d;
@@ -65,11 +90,10 @@ fn one_reflection_beams_match_the_chain_from_a_sampled_medium_vertex() {
     let mut light = Sampler::new(31, 1);
     let mut camera = Sampler::new(32, 1);
     let started = std::time::Instant::now();
-    for x_a in [Vec3::new(0.1, -0.2, 0.3), Vec3::new(-0.5, 0.1, -0.2), Vec3::new(0.2, 0.6, -0.1)] {
+    for &x_a in points {
         let wi = Vec3::new(0.0, -1.0, 0.0);
         let v = Scatter { medium: 0, p: x_a, wi, depth: 1, max_depth: u32::MAX, beta: Spectrum::ONE };
         // Beams with one reflection.
-        let n_beams = 1 << 21;
         let (mut sum, mut sq) = (0.0, 0.0);
         for _ in 0..n_beams {
             let set = beam::trace(&scene, 0, &boundary, &mut light, &mut stats);
@@ -81,7 +105,6 @@ fn one_reflection_beams_match_the_chain_from_a_sampled_medium_vertex() {
         }
         let (b_mean, b_se) = mean_se(sum, sq, n_beams);
         // The chain at a medium vertex sampled from x_a (f_p / pdf = 1, σ_s T / (σ_t T) = albedo).
-        let n_chain = 1 << 18;
         let (mut sum, mut sq) = (0.0, 0.0);
         for _ in 0..n_chain {
             let w = uniform_dir(&mut camera);
@@ -99,6 +122,7 @@ fn one_reflection_beams_match_the_chain_from_a_sampled_medium_vertex() {
         let (c_mean, c_se) = mean_se(sum, sq, n_chain);
         let z = (b_mean - c_mean) / (b_se * b_se + c_se * c_se).sqrt();
         eprintln!("x_a {x_a}: beams {b_mean:.6} ± {b_se:.6}, chain {c_mean:.6} ± {c_se:.6}, z {z:.2}");
+        eprintln!("  so far: chain solutions {} capped {}", stats.chain_solutions, stats.chain_trials_capped);
         assert!(z.abs() < 4.0, "beams {b_mean} ± {b_se} vs chain {c_mean} ± {c_se}");
         assert!(b_mean > 0.0);
     }
