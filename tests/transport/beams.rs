@@ -163,3 +163,21 @@ fn info_and_stats_say_whether_beams_ran() {
         assert_eq!(json["rejected_samples"].as_u64().unwrap(), 0, "{json}");
     }
 }
+
+/// With `reflection_chains`, the chain skips the vertices whose predecessor is a medium vertex
+/// where beams run (the partition of docs/beams.md): fewer chain attempts with beams than without,
+/// and still some (vertices after a surface event).
+#[test]
+fn chain_skips_medium_predecessors_where_beams_run() {
+    use snee::render::{render, RenderOptions};
+    let chains = r#"<boolean name="reflection_chains" value="true"/>"#;
+    let attempts = |props: &str| {
+        let scene = common::scene(&ball_scene(props), &[]);
+        let opts = RenderOptions { spp: Some(4), seed: 3, time_budget: None, progress: false };
+        let json = render(&scene, &opts, &AtomicBool::new(false)).stats.to_json();
+        json["chain_attempts"].as_u64().unwrap()
+    };
+    let with_beams = attempts(chains);
+    let without = attempts(&format!(r#"{chains}<boolean name="beams" value="false"/>"#));
+    assert!(with_beams > 0 && with_beams < without, "chain attempts {with_beams} with beams, {without} without");
+}
