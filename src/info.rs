@@ -205,6 +205,12 @@ fn forward_only(scene: &Scene) -> bool {
     matches!(&scene.integrator, Integrator::VolpathSnee(_, s) if s.forward_only)
 }
 
+/// Do beams run for some medium (`manifold/beam.rs`: `connection = complete`, `beams`, a
+/// directional light, a smooth dielectric boundary)?
+fn beams(scene: &Scene) -> bool {
+    matches!(&scene.integrator, Integrator::VolpathSnee(_, s) if s.beams.iter().any(Option::is_some) && !s.forward_only)
+}
+
 /// Does emitter splitting at smooth dielectric vertices run (`manifold/split.rs`)?
 fn split_glints(scene: &Scene) -> bool {
     matches!(&scene.integrator, Integrator::VolpathSnee(_, s) if s.split.is_some() && !s.forward_only)
@@ -253,6 +259,7 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         integ_json["reflection_chains"] = json!(integ.snee.chains);
         integ_json["forward_only"] = json!(forward_only(scene));
         integ_json["split_glints"] = json!(split_glints(scene));
+        integ_json["beams"] = json!(beams(scene));
     }
     let json = json!({
         "plugins": tree_json(&parsed.root, None),
@@ -311,8 +318,13 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         let _ = write!(text, ", connection = {}", integ.connection.name());
         if forward_only(scene) {
             let _ = write!(text, " (nothing of it applies here: renders with volpath's loop)");
-        } else if split_glints(scene) {
-            let _ = write!(text, ", emitter splitting at smooth dielectric vertices");
+        } else {
+            if split_glints(scene) {
+                let _ = write!(text, ", emitter splitting at smooth dielectric vertices");
+            }
+            if beams(scene) {
+                let _ = write!(text, ", beams (light-traced internal reflections)");
+            }
         }
     }
     let _ = writeln!(text, "{}", if integ.moment { " (inside moment: also m2.R, m2.G, m2.B)" } else { "" });

@@ -77,6 +77,9 @@ pub enum End<'a> {
     Manifold,
     /// The two-vertex chain from the current medium vertex (reflection, refraction): V–S_r–S_t–L.
     Chain,
+    /// A beam connection from the current medium vertex `x_a` (`manifold/beam.rs`):
+    /// V–V–S_r–…–S_r–S_t–L, one or more reflections inside before the exit refraction.
+    Beam,
     /// An emitter hit by the path's ray (after the surface events seen so far).
     Hit,
     /// Emitter sampling at the surface `s` the ray along `d` reached, towards `light_d`.
@@ -235,7 +238,7 @@ impl Tally for Classes {
                 (_, Vertex::Medium { .. }) => PathClass::SneeSupport,
                 _ => PathClass::SurfaceBeforeLast,
             },
-            End::Chain => PathClass::InternalReflection,
+            End::Chain | End::Beam => PathClass::InternalReflection,
             End::Hit => {
                 let mut x_k = self.x_k.take();
                 let class = self.classify(scene, self.after, self.last_transmission, x_k.as_mut());

@@ -52,6 +52,9 @@ impl Default for IntegratorDesc {
 
 /// The integrator as built at scene load: its settings (reachable as fields through `Deref`) and
 /// what it precomputes from the scene.
+/// Built once per scene and read in place by every path (no box: that would put one more
+/// indirection on each of the loop's table look-ups), so the size difference does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum Integrator {
     Path(IntegratorDesc),

@@ -90,4 +90,12 @@ counters! {
     /// rays cast (also counted in `rays`).
     split_lobes,
     split_rays,
+    /// Beams (`manifold/beam.rs`): light subpaths traced from a directional light (one per camera
+    /// sample that reached a medium vertex where beams apply), beams recorded (reflected
+    /// segments), connections of a beam to a camera medium vertex, and of them those whose
+    /// segment `x_a → x_b` was blocked.
+    beam_subpaths,
+    beams,
+    beam_connections,
+    beam_blocked,
 }

@@ -657,6 +657,9 @@ fn trace_from<W: PathWeight, T: Tally, const TRACED: bool>(
                         let c = manifold.chain_at_scatter(cx, &v);
                         result += c;
                         tally.add(scene, c, End::Chain);
+                        let c = manifold.beams_at_scatter(cx, &v);
+                        result += c;
+                        tally.add(scene, c, End::Beam);
                     }
                 }
 

@@ -10,6 +10,7 @@
 //! | `connection` | string  | `paper` (default): the paper's estimator; `complete`: also manifold NEE through flat smooth boundaries (`manifold/`, docs/manifold.md) |
 //! | `reflection_chains` | boolean | with `connection = complete`: also connect through an internal reflection then a refraction (two-vertex chains, `manifold/chain.rs`, docs/manifold.md §9) under a directional light; default `false` (its cost exceeds its gain on the paper's statue) |
 //! | `split_glints` | boolean | with `connection = complete`: emitter splitting at smooth dielectric vertices (`manifold/split.rs`, docs/manifold.md §12): the emitter seen along the lobe that BSDF sampling did not pick is found by one more ray and both lobes are counted with their Fresnel weights, where forward tracing alone makes that suffix (glints of area lights and environments); default `true` |
+//! | `beams` | boolean | with `connection = complete`: light-traced internal-reflection segments (beams) under a directional light behind a smooth `dielectric` boundary, connected to every camera medium vertex inside it (`manifold/beam.rs`, docs/beams.md); default `true` |
 //! | `snee_rate`  | float   | probability `r` of running SNEE at a scattering vertex (default: chosen per medium from its boundary and the lights, see [`snee::auto_rate`], revised under `connection = complete` by `snee::rate::complete_rates`); MIS counts SNEE's density as `r · pdf_snee`, so any `r` is unbiased |
 //! | `connection_rate` | float | with `connection = complete`: the top rate `q_top` in (0, 1] of the curved area-light connection (`manifold/curved_finite.rs`): at a medium vertex `x_j` whose emitter sample picked an area light at `y` it runs with probability `q = q_top · max(e^{−σ_t t0}, 1e-3)`, `t0` the distance from `x_j` to the boundary towards `y`; default `min(0.05, (1/256) / m(τ))` (`curved_finite::RATE`, `curved_finite::default_top_rate`: `m(τ) = (1 − e^{−τ})/τ` of the medium's optical size `τ`, so thin media run it less often; docs/manifold.md §8.2); part of its density, so any `q_top` is unbiased |
 //!
@@ -100,7 +101,8 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
         }
     }
     let split_glints = props.bool("split_glints", true)?;
-    Ok(SneeOptions { technique, transport, rate, chains, connection_rate, split_glints })
+    let beams = props.bool("beams", true)?;
+    Ok(SneeOptions { technique, transport, rate, chains, connection_rate, split_glints, beams })
 }
 
 /// The `connection` parameter (manifold NEE, `integrator/manifold/`).
@@ -130,6 +132,9 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         }
         snee.meter_glint = meter_glint(scene);
         snee.split = manifold::split::tables(scene, snee.options);
+        if snee.options.beams && snee.options.keeps_all() {
+            snee.beams = manifold::beam::beam_boundaries(scene);
+        }
     }
     snee.has_directional = has_directional(scene);
     snee.forward_only = forward_only(scene, &snee, connection);

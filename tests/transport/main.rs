@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod beams;
 mod glint;
 mod manifold_chain;
 mod manifold_curved;

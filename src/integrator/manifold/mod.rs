@@ -23,7 +23,9 @@
 //! §7.2); curved smooth boundaries under a
 //! directional light ([`curved`], Newton and specular manifold sampling in [`newton`], §8) and
 //! under area and sphere lights ([`curved_finite`], [`newton_point`], §8.2); with
-//! `reflection_chains`, two-vertex chains under a directional light ([`chain`], §9); elsewhere
+//! `reflection_chains`, two-vertex chains under a directional light ([`chain`], §9); with
+//! `beams` (default on), light-traced internal-reflection segments under a directional light
+//! connected to every medium vertex inside a smooth boundary ([`beam`], docs/beams.md); elsewhere
 //! it draws no samples and `volpath_snee` is the paper's estimator.
 //!
 //! The interface the volpath loop uses: a [`ManifoldStage`] per path next to SNEE's
@@ -32,6 +34,7 @@
 //! `snee/sample.rs`). The flat boundaries are built at scene load into `volpath_snee`'s tables
 //! ([`Snee::flat`], read through [`tables`]).
 
+pub mod beam;
 pub mod chain;
 pub mod chain_seed;
 pub mod curved;

@@ -5,6 +5,7 @@
 //! | loop event                   | call                          | what the manifold connection does                |
 //! |------------------------------|-------------------------------|--------------------------------------------------|
 //! | real scatter `p` in a medium | [`ManifoldStage::at_scatter`] | `x_j = p`; one connection through the flat boundary, MIS-weighted against SNEE run at the previous vertex `x_i` (`manifold::sample`) |
+//! | the same scatter             | [`ManifoldStage::chain_at_scatter`], [`ManifoldStage::beams_at_scatter`] | the two-vertex chain (`reflection_chains`); the beams of one light subpath traced at the path's first such vertex (`beam.rs`) |
 //! | the ray reaches a surface    | [`ManifoldStage::at_surface`] | takes the pending suffixes `x_j → x_k → …` the ray carries |
 //! | an emitter is hit            | [`ManifoldStage::weight`]     | the MIS weight of an escape right after leaving `x_j`'s medium (`manifold::forward_weight`) |
 //! | emitter sampling at `x_k`    | [`ManifoldStage::nee_weight`] | the MIS weight of forward NEE at a rough `x_k` right after `x_j` (`rough::nee_weight`) |
@@ -13,6 +14,7 @@
 //! SNEE's side of the MIS (a SNEE sample the connection could also have made) is one call in
 //! `snee/sample.rs` (`manifold::snee_weight`).
 
+use super::beam::{self, BeamSet};
 use super::curved_finite;
 use super::rough::RoughPending;
 use super::track::{Pending, Tracker};
@@ -62,6 +64,12 @@ pub struct ManifoldStage<'a> {
     /// A path that left through a curved boundary right after `x_j` (`curved_finite.rs`), likewise.
     curved_pending: Option<curved_finite::Pending>,
     curved_arrived: Option<curved_finite::Pending>,
+    /// Did the current ray start at a medium vertex (no surface reached since)?
+    after_scatter: bool,
+    /// Is the predecessor of the current medium vertex a medium vertex, with no surface between?
+    medium_predecessor: bool,
+    /// The beams of this path's light subpath (`beam.rs`), traced at its first vertex that needs them.
+    beams: Option<BeamSet>,
 }
 
 impl<'a> ManifoldStage<'a> {
@@ -78,6 +86,9 @@ impl<'a> ManifoldStage<'a> {
             rough_arrived: None,
             curved_pending: None,
             curved_arrived: None,
+            after_scatter: false,
+            medium_predecessor: false,
+            beams: None,
         })
     }
 
@@ -86,14 +97,48 @@ impl<'a> ManifoldStage<'a> {
     #[inline]
     pub fn at_scatter(&mut self, cx: &mut Cx, snee: &SneeStage, v: &Scatter) -> Spectrum {
         self.x_i = snee.chain_x_i().copied();
+        self.medium_predecessor = std::mem::replace(&mut self.after_scatter, true);
         self.tracker.sample(cx, self.snee.options, snee.chain_x_i(), v)
     }
 
     /// After [`Self::at_scatter`] at the same vertex: the two-vertex chain (`reflection_chains`,
     /// docs/manifold.md §9), returned apart so that the class tally counts it as internal reflection.
+    /// Where beams run, the chain skips vertices whose predecessor is a medium vertex: the beams
+    /// connected at that predecessor make those paths (one reflection), so the two partition them.
     #[inline]
     pub fn chain_at_scatter(&mut self, cx: &mut Cx, v: &Scatter) -> Spectrum {
+        if self.medium_predecessor && self.beams_apply(v.medium) {
+            return Spectrum::ZERO;
+        }
         super::sample_chain(cx, self.snee.options, v)
+    }
+
+    /// Do beams run for a medium vertex in `medium` (`connection = complete`, `beams`, all
+    /// transport kept, a directional light and a smooth dielectric boundary: `Snee::beams`)?
+    #[inline]
+    fn beams_apply(&self, medium: u32) -> bool {
+        self.snee.beams.get(medium as usize).is_some_and(Option::is_some)
+    }
+
+    /// After [`Self::chain_at_scatter`] at the same vertex `x_a = v.p`: every beam of the path's
+    /// light subpath (traced here at the first vertex that needs it) connected to `x_a`
+    /// (`beam.rs`), returned apart (class `internal_reflection`). Zero, drawing nothing, where
+    /// beams do not apply or the depth budget leaves no room for one reflection.
+    #[inline]
+    pub fn beams_at_scatter(&mut self, cx: &mut Cx, v: &Scatter) -> Spectrum {
+        let Some(Some(b)) = self.snee.beams.get(v.medium as usize) else { return Spectrum::ZERO };
+        // x_b, one reflection and the refraction out.
+        if v.depth.saturating_add(3) >= v.max_depth {
+            return Spectrum::ZERO;
+        }
+        let set = match &self.beams {
+            Some(set) if set.medium == v.medium => set,
+            _ => self.beams.insert(beam::trace(cx.scene, v.medium, b, cx.sampler, cx.stats)),
+        };
+        if set.n == 0 {
+            return Spectrum::ZERO;
+        }
+        beam::connect(cx.scene, set, v, beam::MAX_REFLECTIONS as u32, cx.sampler, cx.stats)
     }
 
     /// The weight of forward NEE towards `ds` at the current surface, when it is a rough `x_k`
@@ -114,6 +159,7 @@ impl<'a> ManifoldStage<'a> {
     /// The ray reached a surface (`None`: it escaped).
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
+        self.after_scatter = false;
         shift(&mut self.arrived, &mut self.tracker.pending);
         shift(&mut self.rough_arrived, &mut self.rough_pending);
         shift(&mut self.curved_arrived, &mut self.curved_pending);

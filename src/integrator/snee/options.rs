@@ -33,6 +33,9 @@ pub struct SneeOptions {
     /// `split_glints` (with `connection = complete`): emitter splitting at smooth dielectric
     /// vertices (`manifold/split.rs`).
     pub split_glints: bool,
+    /// `beams` (with `connection = complete`): light-traced internal-reflection segments under a
+    /// directional light, connected to camera medium vertices (`manifold/beam.rs`).
+    pub beams: bool,
 }
 
 impl Default for SneeOptions {
@@ -44,6 +47,7 @@ impl Default for SneeOptions {
             chains: false,
             connection_rate: None,
             split_glints: true,
+            beams: true,
         }
     }
 }
@@ -96,6 +100,9 @@ pub struct Snee {
     /// With `connection = complete` and `split_glints`: what emitter splitting at smooth
     /// dielectric vertices needs of the scene (`manifold::split`); `None` where it does not run.
     pub split: Option<crate::integrator::manifold::split_bounds::SplitTables>,
+    /// With `connection = complete` and `beams`: per medium, the boundary where beams apply
+    /// (`manifold::beam::beam_boundaries`); empty elsewhere.
+    pub beams: Vec<Option<crate::integrator::manifold::beam::BeamBoundary>>,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).

@@ -24,6 +24,7 @@ pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
         has_directional: false,
         meter_glint: None,
         split: None,
+        beams: Vec::new(),
     }
 }
 
