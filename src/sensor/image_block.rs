@@ -33,6 +33,12 @@ pub struct ImageBlock {
     /// Gaussian at most 8 pixels wide per axis, a CPU with AVX2 and FMA, and storage coordinates
     /// exact in `f32` (decided in [`ImageBlock::reset`]).
     rgb_gaussian_avx2: bool,
+    /// Whether [`ImageBlock::put_rgb`] adds into one pixel directly: three channels and the box
+    /// kernel (decided in [`ImageBlock::reset`]).
+    rgb_box: bool,
+    /// The storage's first pixel in film coordinates and its width in pixels (for `put_rgb_box`).
+    box_origin: (i32, i32),
+    box_width: usize,
     /// The storage's first and last pixel in film coordinates, `(x, y, x, y)` in `f32`.
     clip: [f32; 4],
     /// Storage (interior plus border), row-major, `channels` values then the weight per pixel.
@@ -51,6 +57,9 @@ impl ImageBlock {
             filter,
             kernel: FilterKernel::for_splatting(&filter),
             rgb_gaussian_avx2: false,
+            rgb_box: false,
+            box_origin: (0, 0),
+            box_width: 0,
             clip: [0.0; 4],
             data: Vec::new(),
         };
@@ -73,7 +82,10 @@ impl ImageBlock {
             && exact(ox, w)
             && exact(oy, h)
             && has_avx2_fma();
+        self.rgb_box = self.channels == 3 && matches!(self.kernel, FilterKernel::Box) && exact(ox, w) && exact(oy, h);
         self.clip = [ox as f32, oy as f32, (ox + w as i64 - 1) as f32, (oy + h as i64 - 1) as f32];
+        self.box_origin = (ox as i32, oy as i32);
+        self.box_width = w;
     }
 
     /// Zero all pixels and weights.
@@ -124,7 +136,35 @@ impl ImageBlock {
                 }
             }
         }
+        if self.rgb_box {
+            if let Ok(&rgb) = <&[f32; 3]>::try_from(values) {
+                self.put_rgb_box(pos, rgb);
+                return;
+            }
+        }
         self.put_general(pos, values);
+    }
+
+    /// The box kernel's path of [`ImageBlock::put_general`] for three channels: the same pixel
+    /// (the one containing `pos`), the same four additions (values, then weight 1), so the same bits.
+    /// The position is tested against the storage's edges in `f32` (exact: `rgb_box` requires
+    /// storage coordinates below 2^24), which also rejects NaN and every position whose floor
+    /// would not fit, so the floor itself needs no saturation.
+    #[inline(always)]
+    fn put_rgb_box(&mut self, pos: Vec2, rgb: [f32; 3]) {
+        let [x0, y0, x1, y1] = self.clip;
+        // floor(p) in [first, last] <=> first <= p < last + 1, both sides exact in f32.
+        if !(pos.x >= x0 && pos.x < x1 + 1.0 && pos.y >= y0 && pos.y < y1 + 1.0) {
+            return;
+        }
+        let (x, y) = (floor_in_range(pos.x) - self.box_origin.0, floor_in_range(pos.y) - self.box_origin.1);
+        let base = (y as usize * self.box_width + x as usize) * 4;
+        if let Some(px) = self.data.get_mut(base..base + 4) {
+            px[0] += rgb[0];
+            px[1] += rgb[1];
+            px[2] += rgb[2];
+            px[3] += 1.0;
+        }
     }
 
     /// [`ImageBlock::put`] for any filter and channel count.
@@ -414,6 +454,15 @@ fn floor_i64(v: f32) -> i64 {
     i - ((i as f32) > v) as i64
 }
 
+/// `v.floor() as i32` for `|v| < 2^24` (the caller's range test; also excludes NaN).
+#[inline(always)]
+fn floor_in_range(v: f32) -> i32 {
+    debug_assert!(v.abs() < 16_777_216.0);
+    // SAFETY: |v| < 2^24 (asserted by the caller's comparisons), so the truncation fits in an i32.
+    let i: i32 = unsafe { v.to_int_unchecked() };
+    i - ((i as f32) > v) as i32
+}
+
 /// `v.ceil() as i64` for finite `v` (see [`floor_i64`]).
 #[inline(always)]
 fn ceil_i64(v: f32) -> i64 {
@@ -623,6 +672,35 @@ mod tests {
         assert_eq!(img[1], 3.0);
         assert_eq!(img.iter().filter(|v| **v != 0.0).count(), 1);
         assert_eq!(b.weight(1, 0), 2.0);
+    }
+
+    #[test]
+    fn rgb_box_matches_general_path() {
+        // Negative and positive storage origins, positions on and next to every pixel edge, outside
+        // the storage, huge and non-finite.
+        for offset in [(-3, 5), (0, 0), (1000, -20)] {
+            let mut fast = ImageBlock::new(offset, (7, 4), RFilter::Box, 3);
+            let mut general = fast.clone();
+            assert!(fast.rgb_box);
+            let mut coords = vec![f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e30, -1e30, 16_777_216.0];
+            for i in -8..16 {
+                let e = (offset.0.min(offset.1) + i) as f32;
+                coords.extend([e, e.next_up(), e.next_down(), e + 0.5, e + 0.999_999_94]);
+            }
+            coords.extend([offset.0 as f32 + 3.25, offset.1 as f32 + 2.75]);
+            let mut k = 0.0f32;
+            for &x in &coords {
+                for &y in &coords {
+                    k += 1.0;
+                    let rgb = [k, 0.5 * k, 0.25 + k];
+                    fast.put(Vec2::new(x, y), &rgb);
+                    general.put_general(Vec2::new(x, y), &rgb);
+                }
+            }
+            assert!(fast.data.iter().any(|&v| v != 0.0));
+            let bits = |b: &ImageBlock| b.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&fast), bits(&general), "offset {offset:?}");
+        }
     }
 
     #[test]
