@@ -25,6 +25,7 @@
 //! predecessor is a medium vertex where beams run (`ManifoldStage::chain_at_scatter`), so the MIS
 //! weight is 1.
 
+pub use super::beam_boundary::BeamBoundary;
 use super::MediumVertex;
 use crate::bsdf::{flags, Bsdf, BsdfContext, TransportMode};
 use crate::color::Spectrum;
@@ -48,13 +49,6 @@ const ROULETTE_SHARE: f32 = 0.05;
 const ROULETTE_MIN: f32 = 0.05;
 /// Interfaces crossed (passable surfaces) before the light reaches the boundary, at most.
 const MAX_PASSES: u32 = 64;
-
-/// Where beams apply for one medium: the bounding sphere of its smooth dielectric boundary.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BeamBoundary {
-    pub center: Vec3,
-    pub radius: f32,
-}
 
 /// Per medium of `scene`: the boundary where beams apply, built at scene load (with `connection =
 /// complete` and `beams`): the scene has a directional light, the medium samples emitters, and

@@ -35,6 +35,7 @@
 //! ([`Snee::flat`], read through [`tables`]).
 
 pub mod beam;
+pub mod beam_boundary;
 pub mod chain;
 pub mod chain_seed;
 pub mod curved;

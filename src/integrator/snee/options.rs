@@ -102,7 +102,7 @@ pub struct Snee {
     pub split: Option<crate::integrator::manifold::split_bounds::SplitTables>,
     /// With `connection = complete` and `beams`: per medium, the boundary where beams apply
     /// (`manifold::beam::beam_boundaries`); empty elsewhere.
-    pub beams: Vec<Option<crate::integrator::manifold::beam::BeamBoundary>>,
+    pub beams: Vec<Option<crate::integrator::manifold::beam_boundary::BeamBoundary>>,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).
