@@ -119,6 +119,7 @@ pub fn parse_connection(props: &Props) -> Result<Connection> {
 /// complete` the manifold connection's flat boundaries, built once at scene load.
 pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Snee {
     let mut snee = snee::rate::build(scene, options);
+    snee.has_directional = has_directional(scene);
     if connection == Connection::Complete {
         snee.flat = manifold::flat::flat_boundaries(scene);
         snee.rough = manifold::rough::rough_boundaries(scene);
@@ -132,11 +133,10 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         }
         snee.meter_glint = meter_glint(scene);
         snee.split = manifold::split::tables(scene, snee.options);
-        if snee.options.beams && snee.options.keeps_all() {
+        if snee.options.beams && snee.options.keeps_all() && snee.has_directional {
             snee.beams = manifold::beam::beam_boundaries(scene);
         }
     }
-    snee.has_directional = has_directional(scene);
     snee.forward_only = forward_only(scene, &snee, connection);
     snee
 }

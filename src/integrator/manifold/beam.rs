@@ -51,12 +51,11 @@ const ROULETTE_MIN: f32 = 0.05;
 const MAX_PASSES: u32 = 64;
 
 /// Per medium of `scene`: the boundary where beams apply, built at scene load (with `connection =
-/// complete` and `beams`): the scene has a directional light, the medium samples emitters, and
+/// complete`, `beams`, and a directional light in the scene): the medium samples emitters, and
 /// every `dielectric`/`roughdielectric` shape enclosing it (interior = the medium, no exterior
 /// medium) is a smooth `dielectric`, at least one (the enclosure rule of SNEE and §8).
 pub fn beam_boundaries(scene: &Scene) -> Vec<Option<BeamBoundary>> {
-    let directional = scene.emitters.iter().any(|e| matches!(e, SceneEmitter::Other(Emitter::Directional(_))));
-    (0..scene.media.len() as u32).map(|m| if directional { boundary(scene, m) } else { None }).collect()
+    (0..scene.media.len() as u32).map(|m| boundary(scene, m)).collect()
 }
 
 fn boundary(scene: &Scene, medium: u32) -> Option<BeamBoundary> {
@@ -106,15 +105,11 @@ impl BeamSet {
     }
 }
 
-/// Is `si` (reached along `d`) a smooth dielectric shape enclosing `medium`, met from inside
-/// (`inside`) or from outside?
+/// Is `si` (reached along `d`) a smooth dielectric shape enclosing `medium` (`snee::encloses`),
+/// met from inside (`inside`) or from outside?
 fn on_boundary(scene: &Scene, si: &SurfaceInteraction, medium: u32, d: Vec3, inside: bool) -> bool {
-    let s = &scene.shapes[si.shape as usize];
-    let side = d.dot(si.n);
-    s.interior == Some(medium)
-        && s.exterior.is_none()
-        && if inside { side > 0.0 } else { side < 0.0 }
-        && matches!(scene.bsdf(si), Bsdf::Dielectric(_))
+    let from_inside = if inside { d } else { -d };
+    crate::integrator::snee::encloses(scene, si, medium, from_inside) && matches!(scene.bsdf(si), Bsdf::Dielectric(_))
 }
 
 /// The adjoint BSDF's shading-normal factor (Veach 1997, §5.3): light arriving from `w_in`
