@@ -16,17 +16,6 @@ use crate::scene::world::{Scene, SceneEmitter};
 /// Radiance along `ray` (one sample), and whether the camera ray hit a surface (the alpha channel).
 pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-        && std::arch::is_x86_feature_detected!("avx512bw")
-        && std::arch::is_x86_feature_detected!("avx512dq")
-        && std::arch::is_x86_feature_detected!("avx2")
-        && std::arch::is_x86_feature_detected!("fma")
-    {
-        // SAFETY: the CPU supports these features (checked just above).
-        return unsafe { li_avx512(scene, sampler, ray, stats) };
-    }
-    #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU supports AVX2 and FMA (checked just above).
         return unsafe { li_avx2(scene, sampler, ray, stats) };
@@ -40,13 +29,6 @@ pub fn li(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn li_avx2(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
-    li_impl(scene, sampler, ray, stats)
-}
-
-/// [`li`] compiled for AVX-512 (32 vector registers, masks).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx2,fma")]
-fn li_avx512(scene: &Scene, sampler: &mut Sampler, ray: Ray, stats: &mut LocalStats) -> (Spectrum, bool) {
     li_impl(scene, sampler, ray, stats)
 }
 

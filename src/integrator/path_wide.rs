@@ -231,13 +231,9 @@ struct Lanes {
     /// Next-event contribution if the emitter is visible; `shadow`: a shadow ray is needed.
     contrib: V3,
     shadow: [bool; N],
-    /// BSDF sample: succeeded, new throughput, its largest channel, direction, origin, pdf.
+    /// BSDF sample: succeeded, the new throughput's largest channel.
     sampled: [bool; N],
-    beta_next: V3,
     beta_max: [f32; N],
-    wo_world: V3,
-    origin: V3,
-    bs_pdf: [f32; N],
 }
 
 /// `fast::sincos_2pi` (the same constants and operations) with its quadrant switch as selects.
@@ -359,13 +355,19 @@ fn shade(w: &mut Lanes) {
         let wo = square_to_cosine_hemisphere(w.sample2[l]);
         let pdf = cosine_hemisphere_pdf(wo.z);
         w.sampled[l] = !(wi_z <= 0.0) && pdf > 0.0 && reflectance.max_element() > 0.0;
-        w.bs_pdf[l] = pdf;
-        let beta_next = beta * reflectance;
-        w.beta_next.set(l, beta_next);
-        w.beta_max[l] = beta_next.max_element();
+        // The path state moves to the sampled direction in every lane: a lane whose sample failed
+        // (or that is not shading) ends its path, and a new path sets all of this afresh.
+        let beta = beta * reflectance;
+        w.beta.set(l, beta);
+        w.beta_max[l] = beta.max_element();
+        let p = w.p.get(l);
         let wo_world = frame.to_world(wo);
-        w.wo_world.set(l, wo_world);
-        w.origin.set(l, offset_origin(w.p.get(l), w.n.get(l), wo_world));
+        w.ray_d.set(l, wo_world);
+        w.ray_o.set(l, offset_origin(p, w.n.get(l), wo_world));
+        w.prev_p.set(l, p);
+        w.prev_bsdf_pdf[l] = pdf;
+        w.prev_bsdf_delta[l] = false;
+        w.depth[l] += 1;
     }
 }
 
@@ -471,9 +473,9 @@ fn render_impl(
         // The live lanes as a list: the loops below visit them without a branch per lane.
         let mut lanes = [0usize; N];
         let mut n_live = 0;
-        for l in 0..N {
+        for (l, &is_live) in live.iter().enumerate() {
             lanes[n_live] = l;
-            n_live += live[l] as usize;
+            n_live += is_live as usize;
         }
         if n_live == 0 {
             break;
@@ -592,14 +594,6 @@ fn render_impl(
                 finish!(l);
                 continue;
             }
-            w.beta.set(l, w.beta_next.get(l));
-            w.ray_o.set(l, w.origin.get(l));
-            w.ray_d.set(l, w.wo_world.get(l));
-            w.prev_p.set(l, w.p.get(l));
-            w.prev_bsdf_pdf[l] = w.bs_pdf[l];
-            w.prev_bsdf_delta[l] = false;
-            w.depth[l] += 1;
-
             // ---- Russian roulette (`eta` stays 1: diffuse does not refract) ----
             let beta_max = w.beta_max[l];
             if !(beta_max > 0.0 && beta_max < f32::INFINITY) {
