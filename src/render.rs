@@ -294,11 +294,11 @@ pub fn render_range(
             }
         };
 
+    // `path` on diffuse scenes renders several pixels at once (`integrator/path_wide.rs`).
+    let wide = path_wide::applies(scene);
     // One tile's samples `next..pass_end` of every pixel (the chunk starting at `chunk` replayed
     // up to `next`), splatted into a block of its own with the samples' count; `None` when
     // cancelled before it started.
-    // `path` on diffuse scenes renders several pixels at once (`integrator/path_wide.rs`).
-    let wide = path_wide::applies(scene);
     let render_tile = |&(x0, y0, w, h): &(i32, i32, u32, u32), chunk: u32, next: u32, pass_end: u32| {
         let (replay, pass_spp) = (next - chunk, pass_end - next);
         if cancel.load(Ordering::Relaxed) {

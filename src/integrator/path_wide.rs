@@ -3,19 +3,27 @@
 //!
 //! A lane is a pixel of the tile: it runs that pixel's samples one after the other from the
 //! pixel's own sampler stream, exactly as the scalar loop does, and when its pixel has done its
-//! samples it takes the next pixel of the tile (refill), until every pixel is done. Rays are
-//! traced one lane at a time (`Scene::ray_intersect`, the emitter sampling and the shadow rays are
-//! the scalar code's own calls); the diffuse BSDF (evaluation, pdf, cosine-weighted sampling with
-//! its concentric-disk warp), the shading frames, MIS weights, the new ray's origin offset and the
-//! throughput update run as loops over the lanes' structure-of-arrays state, which the compiler
-//! turns into 8-wide vector code. Every lane does the scalar code's float operations in its order
-//! (IEEE `+ - * / sqrt` are exact per lane; the polynomial `sincos` is written out with the same
-//! constants and association), so each sample's radiance is the scalar one bit for bit.
+//! samples it takes the next pixel of the tile (refill), until every pixel is done. A step of the
+//! loop takes every live lane one vertex further:
+//! 1. per lane (scalar): the ray (`Scene::ray_intersect`), emission found by it (the scalar code's
+//!    calls), the end of the path, the vertex (position, normals, frame, reflectance) into
+//!    structure-of-arrays state;
+//! 2. vector loops over the lanes: the vertex's five sampler numbers (PCG32 on the lanes' streams,
+//!    [`Pcg`]), then, with area lights on meshes, the emitter sample's direction, density and
+//!    weight and its shadow ray, after a scalar pick of the light and of its point
+//!    (`Scene::select_emitter`, `Shape::sample_position`; other lights: the scalar
+//!    `sample_emitter_direction`), then the diffuse BSDF (evaluation, pdf, cosine-weighted
+//!    sampling with its concentric-disk warp), frames, MIS, the new ray and the throughput;
+//! 3. per lane (scalar): the shadow ray (`Scene::ray_test`), Russian roulette, path ends.
 //!
-//! Samples are buffered per pixel and handed to the caller's splat in the scalar order (pixel by
-//! pixel in tile order, samples in order), so the tile's block sums are the scalar ones too.
-//! Decided per render (`applies`): `path` without class AOVs, every shape's BSDF `diffuse`; every
-//! other scene keeps the scalar loop.
+//! The compiler turns the loops of step 2 into 8-wide AVX2 / AVX-512 code (runtime-detected).
+//! Every lane does the scalar code's float operations in its order (IEEE `+ - * / sqrt` are exact
+//! per lane; the polynomial `sincos` and the branches of the warps are written as selects with the
+//! same constants and association, tested bit for bit below), so each sample's radiance is the
+//! scalar one bit for bit. Finished samples are buffered and splatted after the tile in the scalar
+//! order (pixel by pixel, samples in order), so the block sums are the scalar ones too
+//! (`tests/path_wide.rs`). Decided per render ([`applies`]): `path` without class AOVs, every
+//! shape's BSDF `diffuse`; every other scene keeps the scalar loop.
 
 use super::stats::LocalStats;
 use super::Integrator;
