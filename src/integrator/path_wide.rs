@@ -16,7 +16,8 @@
 //!    sampling with its concentric-disk warp), frames, MIS, the new ray and the throughput;
 //! 3. per lane (scalar): the shadow ray (`Scene::ray_test`), Russian roulette, path ends.
 //!
-//! The compiler turns the loops of step 2 into 8-wide AVX2 / AVX-512 code (runtime-detected).
+//! The compiler turns the loops of step 2 into AVX2 (2 × 8 lanes) or AVX-512 (16 lanes) code,
+//! chosen at run time.
 //! Every lane does the scalar code's float operations in its order (IEEE `+ - * / sqrt` are exact
 //! per lane; the polynomial `sincos` and the branches of the warps are written as selects with the
 //! same constants and association, tested bit for bit below), so each sample's radiance is the
@@ -35,8 +36,10 @@ use crate::scene::world::{Scene, SceneEmitter};
 use crate::shape::Geometry;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Paths in flight (one per pixel).
-pub const LANES: usize = 8;
+/// Paths in flight (one per pixel): 16, one AVX-512 register of `f32` (measured on cornell_box,
+/// 1 thread, against 8: render time 0.587 vs 0.614 s, medians of 7 pairs; under AVX2 +0.4 %
+/// instructions, −6 % mispredicted branches in callgrind's model).
+pub const LANES: usize = 16;
 const N: usize = LANES;
 
 /// Off switch (on by default): the scalar loop renders every scene while this is false (tests
