@@ -401,10 +401,11 @@ fn render_impl(
     let valid0 = !desc.hide_emitters && scene.environment.is_some();
     let total = replay + spp;
     // Area lights on meshes and disks (points sampled by area): emitter sampling in `emitter_rays`.
-    let mesh_lights = scene.emitters.iter().all(|e| match e {
-        SceneEmitter::Area { shape, .. } => !matches!(scene.shapes[*shape as usize].geometry, Geometry::Sphere(_)),
-        SceneEmitter::Other(_) => false,
-    });
+    let mesh_lights = !scene.emitters.is_empty()
+        && scene.emitters.iter().all(|e| match e {
+            SceneEmitter::Area { shape, .. } => !matches!(scene.shapes[*shape as usize].geometry, Geometry::Sphere(_)),
+            SceneEmitter::Other(_) => false,
+        });
     // Finished samples by pixel, splatted in pixel order at the end (flushing pixel by pixel as
     // they complete costs a mispredicted branch per pixel).
     let mut out = vec![(Vec2::ZERO, Spectrum::ZERO, false); pixels.len() * spp as usize];
