@@ -17,6 +17,7 @@
 
 use crate::color::Spectrum;
 use crate::integrator::classes::{ClassValues, PathClass, N_CLASSES};
+use crate::integrator::path_wide::{self, Pixel};
 use crate::integrator::stats::{LocalStats, Stats};
 use crate::integrator::IntegratorKind;
 use crate::math::Vec2;
@@ -293,6 +294,8 @@ pub fn render_range(
             }
         };
 
+    // `path` on diffuse scenes renders several pixels at once (`integrator/path_wide.rs`).
+    let wide = path_wide::applies(scene);
     // One tile's samples `next..pass_end` of every pixel (the chunk starting at `chunk` replayed
     // up to `next`), splatted into a block of its own with the samples' count; `None` when
     // cancelled before it started.
@@ -306,38 +309,55 @@ pub fn render_range(
         let mut replayed = LocalStats::default();
         let mut values = vec![0.0f32; nch];
         let mut split = [Spectrum::ZERO; N_CLASSES];
-        for y in y0..y0 + h as i32 {
-            for x in x0..x0 + w as i32 {
-                // Unique per film pixel (the border may lie outside the film: offset it).
-                let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
-                let mut sampler =
-                    Sampler::new(opts.seed, pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(chunk as u64));
-                for _ in 0..replay {
-                    take_sample(&mut sampler, &mut replayed, x, y, classes.then_some(&mut split));
-                }
-                for _ in 0..pass_spp {
-                    let (pos, l, valid) = take_sample(&mut sampler, &mut local, x, y, classes.then_some(&mut split));
-                    values[..3].copy_from_slice(&l.to_array());
-                    let mut k = 3;
-                    if rgba {
-                        values[3] = if valid { 1.0 } else { 0.0 };
-                        k = 4;
-                    }
+        // One sample into the block: its channels in `channels`' order.
+        let mut put = |pos: Vec2, l: Spectrum, valid: bool, split: &ClassValues| {
+            values[..3].copy_from_slice(&l.to_array());
+            let mut k = 3;
+            if rgba {
+                values[3] = if valid { 1.0 } else { 0.0 };
+                k = 4;
+            }
+            if moment {
+                values[k..k + 3].copy_from_slice(&(l * l).to_array());
+                k += 3;
+            }
+            if classes {
+                for v in split {
+                    values[k..k + 3].copy_from_slice(&v.to_array());
+                    k += 3;
                     if moment {
-                        values[k..k + 3].copy_from_slice(&(l * l).to_array());
+                        values[k..k + 3].copy_from_slice(&(*v * *v).to_array());
                         k += 3;
                     }
-                    if classes {
-                        for v in &split {
-                            values[k..k + 3].copy_from_slice(&v.to_array());
-                            k += 3;
-                            if moment {
-                                values[k..k + 3].copy_from_slice(&(*v * *v).to_array());
-                                k += 3;
-                            }
-                        }
+                }
+            }
+            block.put(pos, &values);
+        };
+        // Unique per film pixel (the border may lie outside the film: offset it).
+        let stream_at = |x: i32, y: i32| {
+            let pixel_index = (y + 64) as u64 * (film.width as u64 + 128) + (x + 64) as u64;
+            pixel_index.wrapping_mul(0x1_0000_0000).wrapping_add(chunk as u64)
+        };
+        if wide {
+            // `path` on diffuse scenes: several pixels at once, the same samples in the same order.
+            let pixels: Vec<Pixel> = (y0..y0 + h as i32)
+                .flat_map(|y| (x0..x0 + w as i32).map(move |x| (x, y)))
+                .map(|(x, y)| Pixel { x, y, seed: opts.seed, stream: stream_at(x, y) })
+                .collect();
+            let mut splat = |pos: Vec2, l: Spectrum, valid: bool| put(pos, l, valid, &split);
+            path_wide::render_pixels(scene, &pixels, replay, pass_spp, moment, &mut local, &mut replayed, &mut splat);
+        } else {
+            for y in y0..y0 + h as i32 {
+                for x in x0..x0 + w as i32 {
+                    let mut sampler = Sampler::new(opts.seed, stream_at(x, y));
+                    for _ in 0..replay {
+                        take_sample(&mut sampler, &mut replayed, x, y, classes.then_some(&mut split));
                     }
-                    block.put(pos, &values);
+                    for _ in 0..pass_spp {
+                        let (pos, l, valid) =
+                            take_sample(&mut sampler, &mut local, x, y, classes.then_some(&mut split));
+                        put(pos, l, valid, &split);
+                    }
                 }
             }
         }

@@ -24,6 +24,7 @@ pub mod enclosure;
 pub mod manifold;
 pub mod moment;
 pub mod path;
+pub mod path_wide;
 pub mod snee;
 pub mod stats;
 pub mod technique;
