@@ -3,12 +3,16 @@
 //!
 //! ```sh
 //! cargo run --release --example bench_traversal -- [SCENE.xml]... [--rays N] [--reps N] [--json]
+//!     [--save-rays DIR]
 //! ```
 //! Default scenes: `scenes/cornell_box.xml` and the paper statue (`scenes/paper/sphere_smooth_st02.xml`).
 //! Rays leave random surface points (cosine-distributed about the normal, half of them turned
 //! inward), as in path tracing; shadow rays join two random surface points. The ray set depends
 //! only on the scene and the seed, so instruction counts (`valgrind --tool=callgrind`, with a small
-//! `--rays`) are comparable between builds.
+//! `--rays`) are comparable between builds. `--save-rays DIR` also writes each scene's rays to
+//! `DIR/<scene>.rays` (little-endian `f32`, per ray o, d, tmax; the closest rays, then the shadow
+//! rays), so that another renderer can trace the same ones (`scripts/embree_rays.py` times Mitsuba
+//! 3's Embree on them).
 
 use snee::interaction::{offset_origin, spawn_ray_between};
 use snee::math::{warp, Frame, Ray};
@@ -18,12 +22,14 @@ use std::time::Instant;
 fn main() {
     let mut scenes = Vec::new();
     let (mut n, mut reps, mut json) = (200_000usize, 5usize, false);
+    let mut save: Option<std::path::PathBuf> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--rays" => n = args.next().and_then(|s| s.parse().ok()).expect("--rays N"),
             "--reps" => reps = args.next().and_then(|s| s.parse().ok()).expect("--reps N"),
             "--json" => json = true,
+            "--save-rays" => save = Some(args.next().expect("--save-rays DIR").into()),
             _ => scenes.push(a),
         }
     }
@@ -59,6 +65,20 @@ fn main() {
             rays.push(Ray::new(offset_origin(ps.p, ps.n, d), d));
             let q = pick(&mut s).sample_position(s.next_2d()).p;
             shadow.push(spawn_ray_between(offset_origin(ps.p, ps.n, q - ps.p), q));
+        }
+        if let Some(dir) = &save {
+            let name = std::path::Path::new(path).file_stem().map_or("scene".into(), |s| s.to_string_lossy());
+            let bytes: Vec<u8> = rays
+                .iter()
+                .chain(&shadow)
+                .flat_map(|r| [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.tmax])
+                .flat_map(f32::to_le_bytes)
+                .collect();
+            let file = dir.join(format!("{name}.rays"));
+            if let Err(e) = std::fs::create_dir_all(dir).and_then(|_| std::fs::write(&file, bytes)) {
+                eprintln!("{}: {e}", file.display());
+                std::process::exit(1);
+            }
         }
         let (mut best_c, mut best_s) = (f64::INFINITY, f64::INFINITY);
         let (mut hits, mut blocked, mut checksum) = (0usize, 0usize, 0.0f64);

@@ -28,7 +28,8 @@ boundary, sigma_t 2 and 34) with `volpath`, plus the statue with snee's `volpath
 Mitsuba's `volpath`, which has no SNEE), each at 1 and 2 threads (`--threads`), with per-scene sample
 counts (`SUITE`, scaled by `--spp-scale`); then the traversal benchmark
 (`cargo run --release --example bench_traversal`): closest-hit and shadow M rays/s on one thread, bytes
-per triangle, and, when valgrind is installed, instructions per ray (callgrind, 10,000 rays).
+per triangle, Embree's M rays/s on the same rays inside Mitsuba's LLVM variant (`embree_rays.py`), and,
+when valgrind is installed, instructions per ray (callgrind, 10,000 rays).
 Timings on a shared machine are noisy: use `--repeat` and compare ratios measured in the same run.
 
 Usage:
@@ -222,14 +223,32 @@ def callgrind_instructions(binary, scene, function, rays):
     return None
 
 
-def run_traversal(args):
-    """The traversal benchmark: M rays/s (one thread) and, with valgrind, instructions per ray."""
+def run_traversal(args, mi, variant):
+    """The traversal benchmark: M rays/s (one thread) and, with valgrind, instructions per ray; beside
+    it Embree's M rays/s inside Mitsuba's LLVM variant on the same rays (`embree_rays.py`)."""
     print("\nbuilding the traversal benchmark (not timed) ...", flush=True)
     subprocess.run(["cargo", "build", "--release", "--example", "bench_traversal"], cwd=ROOT, check=True)
     binary = os.path.join(ROOT, "target", "release", "examples", "bench_traversal")
     scenes = [os.path.join(ROOT, s) for s in TRAVERSAL_SCENES]
-    proc = subprocess.run([binary, *scenes, "--json"], cwd=ROOT, capture_output=True, text=True, check=True)
+    rays_dir = os.path.join(os.path.abspath(args.out), "rays")
+    proc = subprocess.run([binary, *scenes, "--json", "--save-rays", rays_dir], cwd=ROOT, capture_output=True,
+                          text=True, check=True)
     rows = json.loads(proc.stdout)
+    for row in rows:
+        row["embree_closest_mrays"] = row["embree_shadow_mrays"] = None
+        if "llvm" in variant:
+            import drjit as dr
+            import embree_rays
+            name = os.path.splitext(os.path.basename(row["scene"]))[0]
+            arr = np.fromfile(os.path.join(rays_dir, name + ".rays"), dtype="<f4").reshape(-1, 7)
+            n = len(arr) // 2
+            dr.set_thread_count(1)
+            try:
+                mc, hits, _, ms, blocked, _ = embree_rays.time_queries(
+                    mi, dr, mi.load_file(row["scene"]), (arr[:n], arr[n:]), 5)
+            finally:
+                dr.set_thread_count(os.cpu_count())
+            row.update(embree_closest_mrays=mc, embree_shadow_mrays=ms, embree_hits=hits, embree_blocked=blocked)
     have_valgrind = not args.no_callgrind and subprocess.run(["which", "valgrind"], capture_output=True).returncode == 0
     for row in rows:
         row["closest_instructions_per_ray"] = row["shadow_instructions_per_ray"] = None
@@ -239,12 +258,14 @@ def run_traversal(args):
             row["shadow_instructions_per_ray"] = callgrind_instructions(
                 binary, row["scene"], "snee::shape::accel::Accel::occluded", 10000)
     print("\n| scene | triangles | BVH bytes / triangle | load + build s | closest Mrays/s | shadow Mrays/s | "
-          "instructions / closest ray | instructions / shadow ray |")
-    print("|---|---|---|---|---|---|---|---|")
+          "Embree closest / shadow Mrays/s (same rays) | instructions / closest ray | instructions / shadow ray |")
+    print("|---|---|---|---|---|---|---|---|---|")
     fmt = lambda v: "-" if v is None else f"{v:.0f}"  # noqa: E731
     for r in rows:
+        embree = "-" if r["embree_closest_mrays"] is None else \
+            f"{r['embree_closest_mrays']:.2f} / {r['embree_shadow_mrays']:.2f}"
         print(f"| {os.path.relpath(r['scene'], ROOT)} | {r['triangles']} | {r['bytes_per_triangle']:.1f} | "
-              f"{r['load_s']:.3f} | {r['closest_mrays']:.2f} | {r['shadow_mrays']:.2f} | "
+              f"{r['load_s']:.3f} | {r['closest_mrays']:.2f} | {r['shadow_mrays']:.2f} | {embree} | "
               f"{fmt(r['closest_instructions_per_ray'])} | {fmt(r['shadow_instructions_per_ray'])} |")
     return rows
 
@@ -299,7 +320,7 @@ def main():
     print_table(results)
     summary = dict(results=results)
     if suite and not args.no_traversal:
-        summary["traversal"] = run_traversal(args)
+        summary["traversal"] = run_traversal(args, mi, variant)
     print(f"\n(machine: {os.cpu_count()} logical CPUs, shared with other jobs: timings are noisy)")
     path = os.path.join(os.path.abspath(args.out), "bench_summary.json")
     with open(path, "w") as fh:

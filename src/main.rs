@@ -140,7 +140,24 @@ fn positive_spp(s: &str) -> Result<u32, String> {
     }
 }
 
+/// Restore the default action of SIGPIPE (end the process quietly), as C programs have it: Rust
+/// ignores the signal, so printing into a closed pipe (`snee compare A B | head -1`) would panic.
+#[cfg(unix)]
+fn default_sigpipe() {
+    extern "C" {
+        fn signal(signum: i32, handler: usize) -> usize;
+    }
+    const SIGPIPE: i32 = 13;
+    const SIG_DFL: usize = 0;
+    // SAFETY: `signal` from the C library with a valid signal number and the default handler.
+    unsafe {
+        signal(SIGPIPE, SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    default_sigpipe();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -67,9 +67,13 @@ impl Scene {
         // instructions, callgrind).
         let shape = hit.shape;
         match &self.shapes[shape as usize].geometry {
-            Geometry::Mesh(m) => {
-                Some(SurfaceInteraction { shape, ..m.interaction(hit.prim, hit.b1, hit.b2, hit.t, ray.d) })
-            }
+            Geometry::Mesh(m) => Some(SurfaceInteraction {
+                shape,
+                ..match self.accel.lane(hit.lane) {
+                    Some((lane, v)) => m.interaction_lane(lane, v, hit.b1, hit.b2, hit.t, ray.d),
+                    None => m.interaction(hit.prim, hit.b1, hit.b2, hit.t, ray.d),
+                }
+            }),
             Geometry::Sphere(s) => Some(SurfaceInteraction { shape, ..s.interaction(hit.t, ray) }),
             Geometry::Disk(d) => Some(SurfaceInteraction { shape, ..d.interaction(hit.t, ray) }),
         }

@@ -11,6 +11,7 @@
 //! shading normal (`interaction::shading_frame`). Face normals and uv tangents do not change per
 //! sample: they are computed once at load.
 
+use super::accel::bvh8::LaneShade;
 use super::mesh_data::MeshData;
 use super::{obj, ply, serialized, Geometry};
 use crate::emitter::distribution::Distribution1D;
@@ -175,10 +176,24 @@ impl Mesh {
     /// where the interpolation vanishes.
     #[inline(always)]
     fn shading_normal(&self, idx: [u32; 3], n: Vec3A, b0: f32, b1: f32, b2: f32) -> Vec3A {
+        self.shading_normal_from(|| idx.map(|i| self.normals[i as usize]), n, b0, b1, b2)
+    }
+
+    /// [`Self::shading_normal`] with the triangle's vertex normals from `vertex_normals` (called
+    /// only when the mesh has vertex normals).
+    #[inline(always)]
+    fn shading_normal_from(
+        &self,
+        vertex_normals: impl FnOnce() -> [Vec3; 3],
+        n: Vec3A,
+        b0: f32,
+        b1: f32,
+        b2: f32,
+    ) -> Vec3A {
         if self.normals.is_empty() {
             return n;
         }
-        let [n0, n1, n2] = idx.map(|i| Vec3A::from(self.normals[i as usize]));
+        let [n0, n1, n2] = vertex_normals().map(Vec3A::from);
         let sh_n = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
         if sh_n == Vec3A::ZERO {
             n
@@ -286,17 +301,58 @@ impl Mesh {
     #[inline(always)]
     pub fn interaction(&self, prim: u32, b1: f32, b2: f32, t: f32, ray_d: Vec3) -> SurfaceInteraction {
         let idx = self.indices[prim as usize];
-        let [p0, p1, p2] = idx.map(|i| Vec3A::from(self.positions[i as usize]));
+        let v = idx.map(|i| Vec3A::from(self.positions[i as usize]));
+        let face_n = self.face_normals[prim as usize];
+        self.interaction_with(prim, v, face_n, || idx.map(|i| self.normals[i as usize]), (b1, b2, t), ray_d)
+    }
+
+    /// [`Self::interaction`] from a BVH lane's record and the leaf's copy of the vertices (the
+    /// same values as the mesh's: the same hit record, bit for bit, without reading the mesh's
+    /// indices, positions, normals and face normals, which a large mesh holds in cold memory).
+    #[inline(always)]
+    pub fn interaction_lane(
+        &self,
+        lane: &LaneShade,
+        v: [Vec3A; 3],
+        b1: f32,
+        b2: f32,
+        t: f32,
+        ray_d: Vec3,
+    ) -> SurfaceInteraction {
+        self.interaction_with(lane.prim, v, lane.face_n, || lane.n, (b1, b2, t), ray_d)
+    }
+
+    /// The record of a BVH lane holding triangle `prim` of this mesh (shape `shape`).
+    pub fn lane_shade(&self, shape: u32, prim: u32) -> LaneShade {
+        let n = if self.normals.is_empty() {
+            [Vec3::ZERO; 3]
+        } else {
+            self.indices[prim as usize].map(|i| self.normals[i as usize])
+        };
+        LaneShade { shape, prim, n, face_n: self.face_normals[prim as usize] }
+    }
+
+    /// The hit record of triangle `prim` with vertices `v`, face normal `face_n` (before
+    /// `flip_normals`) and vertex normals from `vertex_normals`, at barycentrics `(b1, b2)` and distance `t`.
+    #[inline(always)]
+    fn interaction_with(
+        &self,
+        prim: u32,
+        [p0, p1, p2]: [Vec3A; 3],
+        face_n: Vec3,
+        vertex_normals: impl FnOnce() -> [Vec3; 3],
+        (b1, b2, t): (f32, f32, f32),
+        ray_d: Vec3,
+    ) -> SurfaceInteraction {
         let b0 = 1.0 - b1 - b2;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let face_n = self.face_normals[prim as usize];
         let n = if self.flip_normals { -face_n } else { face_n };
         let uv = if !self.hit_uv {
             Vec2::ZERO
         } else if self.uvs.is_empty() {
             Vec2::new(b1, b2)
         } else {
-            let [u0, u1, u2] = idx.map(|i| self.uvs[i as usize]);
+            let [u0, u1, u2] = self.indices[prim as usize].map(|i| self.uvs[i as usize]);
             u0 * b0 + u1 * b1 + u2 * b2
         };
         let [sh_s, sh_t, sh_n] = match self.face_frames.get(prim as usize) {
@@ -309,7 +365,7 @@ impl Mesh {
                     let dp_du = self.face_dp_du[prim as usize];
                     Vec3A::from(if dp_du == Vec3::ZERO { Frame::from_normal(face_n).s } else { dp_du })
                 };
-                shading_frame_a(self.shading_normal(idx, n.into(), b0, b1, b2), dp_du)
+                shading_frame_a(self.shading_normal_from(vertex_normals, n.into(), b0, b1, b2), dp_du)
             }
         };
         // `Frame::to_local(-ray_d)`.

@@ -19,7 +19,7 @@
 //! Node and leaf boxes are exact unions of the (padded) primitive boxes: they come from the
 //! partition pass itself, not from the bins.
 
-use super::bvh8::{Bvh8, Node8, EMPTY, LEAF, LEAF_SIZE};
+use super::bvh8::{Bvh8, LaneShade, Node8, EMPTY, LEAF, LEAF_SIZE};
 use super::triangle::TriPacket4;
 use crate::math::Vec3;
 use glam::{Vec3A, Vec4};
@@ -629,9 +629,8 @@ fn emit(part: &mut Part, prims: &mut [Bounds], ids: &mut [u32], c: Cluster, base
 }
 
 /// The BVH over triangles with boxes `bounds` (which may be padded); `triangle(i)` gives the
-/// vertices of triangle `i` for the leaf packets and the (shape, triangle) pair its lane records.
-/// None when empty.
-pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> ([Vec3; 3], (u32, u32)) + Sync) -> Option<Bvh8> {
+/// vertices of triangle `i` for the leaf packets and the record its lane holds. None when empty.
+pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> ([Vec3; 3], LaneShade) + Sync) -> Option<Bvh8> {
     if bounds.is_empty() {
         return None;
     }
@@ -646,11 +645,11 @@ pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> ([Vec3; 3], (u32, u3
     let (node_count, leaf_count) = part.sizes();
     let (mut nodes, mut leaves) = (Vec::with_capacity(node_count), Vec::with_capacity(leaf_count));
     let root = flatten(part, root, &mut nodes, &mut leaves);
-    let (packets, lane_prims): (Vec<TriPacket4>, Vec<[(u32, u32); LEAF_SIZE]>) = leaves
+    let (packets, lanes): (Vec<TriPacket4>, Vec<[LaneShade; LEAF_SIZE]>) = leaves
         .par_iter()
         .map(|&[start, len]| {
             let mut packet = TriPacket4::EMPTY;
-            let mut lanes = [(u32::MAX, u32::MAX); LEAF_SIZE];
+            let mut lanes = [LaneShade::EMPTY; LEAF_SIZE];
             for (lane, &id) in ids[start as usize..(start + len) as usize].iter().enumerate() {
                 let (tri, r) = triangle(id);
                 packet.set(lane, tri);
@@ -659,7 +658,7 @@ pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> ([Vec3; 3], (u32, u3
             (packet, lanes)
         })
         .unzip();
-    Some(Bvh8 { nodes, packets, lane_prims, root, depth })
+    Some(Bvh8 { nodes, packets, lanes, root, depth })
 }
 
 #[cfg(test)]
@@ -685,14 +684,14 @@ mod tests {
         for pts in cases {
             let tris: Vec<[Vec3; 3]> = pts.iter().map(|&p| [p, p + Vec3::X * 0.1, p + Vec3::Y * 0.1]).collect();
             let b = boxes(&pts);
-            let bvh = build(b.clone(), |i| (tris[i as usize], (0, i))).unwrap();
+            let bvh = build(b.clone(), |i| (tris[i as usize], LaneShade::ids(0, i))).unwrap();
             let mut seen = vec![0u32; pts.len()];
             // (reference, box it must lie in, depth)
             let mut stack = vec![(bvh.root, Bounds { min: Vec3A::NEG_INFINITY, max: Vec3A::INFINITY }, 1)];
             while let Some((r, outer, d)) = stack.pop() {
                 if r & LEAF != 0 {
                     let p = (r & !LEAF) as usize;
-                    for &(_, id) in &bvh.lane_prims[p] {
+                    for id in bvh.lanes[p].iter().map(|l| l.prim) {
                         if id != u32::MAX {
                             seen[id as usize] += 1;
                             let pb = b[id as usize];

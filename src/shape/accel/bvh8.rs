@@ -1,9 +1,11 @@
 //! The 8-wide BVH: nodes with uncompressed `f32` child boxes stored as a structure of arrays (one
-//! AVX register per plane), and leaves of up to four triangles in one SIMD packet.
+//! AVX register per plane), and leaves of up to four triangles in one SIMD packet, each lane with
+//! what its hit record reads in one cache line ([`LaneShade`]).
 //!
 //! Built by the binned SAH builder in [`super::build`].
 
 use super::triangle::TriPacket4;
+use glam::Vec3;
 
 /// Child slot value of a leaf: this bit set, the packet index in the others.
 pub const LEAF: u32 = 1 << 31;
@@ -47,12 +49,37 @@ impl Node8 {
     };
 }
 
+/// What the hit record of a BVH lane reads besides the leaf's vertices: its shape and triangle,
+/// the triangle's vertex normals and its face normal, copied out of the mesh at build time into one
+/// cache line per lane. The closest traversal prefetches the line when the lane becomes the nearest
+/// hit, so the hit record does not wait on three dependent misses (lane → vertex indices →
+/// normals) in large meshes after the traversal ends.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct LaneShade {
+    /// Shape and triangle as the builder's caller numbers them (`u32::MAX` in an unused lane).
+    pub shape: u32,
+    pub prim: u32,
+    /// `Mesh::normals` at the triangle's three vertices (zero when the mesh has none).
+    pub n: [Vec3; 3],
+    /// `Mesh::face_normals[prim]`.
+    pub face_n: Vec3,
+}
+
+impl LaneShade {
+    pub const EMPTY: LaneShade = LaneShade::ids(u32::MAX, u32::MAX);
+
+    /// Shape and triangle only (zero normals).
+    pub const fn ids(shape: u32, prim: u32) -> LaneShade {
+        LaneShade { shape, prim, n: [Vec3::ZERO; 3], face_n: Vec3::ZERO }
+    }
+}
+
 pub struct Bvh8 {
     pub nodes: Vec<Node8>,
     pub packets: Vec<TriPacket4>,
-    /// Per packet and lane: (shape, triangle) as the builder's caller numbers them, or
-    /// `(u32::MAX, u32::MAX)` for an unused lane.
-    pub lane_prims: Vec<[(u32, u32); LEAF_SIZE]>,
+    /// Per packet and lane: the lane's record ([`LaneShade::EMPTY`] for an unused lane).
+    pub lanes: Vec<[LaneShade; LEAF_SIZE]>,
     /// Node 0, or `LEAF | 0` when the whole scene is one packet.
     pub root: u32,
     /// Longest root-to-leaf path in nodes (bounds the traversal stack).
@@ -60,10 +87,10 @@ pub struct Bvh8 {
 }
 
 impl Bvh8 {
-    /// Bytes of nodes, packets and lane indices.
+    /// Bytes of nodes, packets and lane records.
     pub fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<Node8>()
             + self.packets.len() * std::mem::size_of::<TriPacket4>()
-            + self.lane_prims.len() * std::mem::size_of::<[(u32, u32); LEAF_SIZE]>()
+            + self.lanes.len() * std::mem::size_of::<[LaneShade; LEAF_SIZE]>()
     }
 }

@@ -16,13 +16,14 @@ pub mod triangle;
 use super::{Geometry, Shape};
 use crate::math::Ray;
 use build::Bounds;
-use bvh8::Bvh8;
+use bvh8::{Bvh8, LaneShade, LEAF_SIZE};
 use glam::Vec3A;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
 use traverse::{Found, STACK};
 
-/// Closest hit: shape, primitive, barycentrics of vertices 1 and 2, distance.
+/// Closest hit: shape, primitive, barycentrics of vertices 1 and 2, distance, and the BVH lane
+/// that holds the triangle ([`NO_LANE`] for a sphere or disk).
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
     pub shape: u32,
@@ -30,7 +31,11 @@ pub struct Hit {
     pub b1: f32,
     pub b2: f32,
     pub t: f32,
+    pub lane: u32,
 }
+
+/// [`Hit::lane`] of a hit outside the BVH.
+pub const NO_LANE: u32 = u32::MAX;
 
 /// Which node test the CPU runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -116,7 +121,7 @@ impl Accel {
         let bvh = build::build(bounds, |id| {
             let (shape, prim) = shape_prim(&mesh_starts, id);
             match &shapes[shape as usize].geometry {
-                Geometry::Mesh(m) => (m.vertices(prim), (shape, prim)),
+                Geometry::Mesh(m) => (m.vertices(prim), m.lane_shade(shape, prim)),
                 _ => unreachable!("only meshes are in the BVH"),
             }
         });
@@ -127,6 +132,16 @@ impl Accel {
     /// Bytes of the BVH (nodes, triangle packets, per-lane shape and triangle).
     pub fn memory_bytes(&self) -> usize {
         self.bvh.as_ref().map_or(0, |b| b.memory_bytes())
+    }
+
+    /// The record of BVH lane `lane` ([`Hit::lane`]) and its triangle's vertices as the leaf packet
+    /// holds them (the mesh's positions, the same values); `None` for [`NO_LANE`].
+    #[inline(always)]
+    pub fn lane(&self, lane: u32) -> Option<(&LaneShade, [Vec3A; 3])> {
+        let bvh = self.bvh.as_ref()?;
+        let (packet, l) = (lane as usize / LEAF_SIZE, lane as usize % LEAF_SIZE);
+        let (record, v) = (bvh.lanes.get(packet)?, &bvh.packets.get(packet)?.v);
+        Some((&record[l], [0, 1, 2].map(|j| Vec3A::new(v[j][0][l], v[j][1][l], v[j][2][l]))))
     }
 
     /// BVH nodes, leaf packets and depth.
@@ -183,7 +198,7 @@ impl Accel {
             if let Some(t) = super::sphere::intersect_sphere_a(s.center, s.r2, o, d, tmax) {
                 if t < tmax {
                     tmax = t;
-                    best = Some(Hit { shape: s.shape, prim: 0, b1: 0.0, b2: 0.0, t });
+                    best = Some(Hit { shape: s.shape, prim: 0, b1: 0.0, b2: 0.0, t, lane: NO_LANE });
                 }
             }
         }
@@ -238,8 +253,8 @@ fn bvh_hit(bvh: &Bvh8, found: Found) -> Option<Hit> {
         return None;
     }
     let (lane, t, b1, b2) = (found.lane, found.t, found.b1, found.b2);
-    let (shape, prim) = bvh.lane_prims[lane as usize / 4][lane as usize % 4];
-    Some(Hit { shape, prim, b1, b2, t })
+    let l = &bvh.lanes[lane as usize / 4][lane as usize % 4];
+    Some(Hit { shape: l.shape, prim: l.prim, b1, b2, t, lane })
 }
 
 /// Closest hit in a tree too deep for the fixed stack (a heap stack).
@@ -297,7 +312,7 @@ fn disks_closest(
         let Some(t) = disk.intersect(&Ray { o: ray.o, d: ray.d, tmax: ray.tmax }) else { continue };
         if t < tmax || (t == tmax && best.is_some_and(|b| shape < b.shape)) {
             tmax = t;
-            best = Some(Hit { shape, prim: 0, b1: 0.0, b2: 0.0, t });
+            best = Some(Hit { shape, prim: 0, b1: 0.0, b2: 0.0, t, lane: NO_LANE });
         }
     }
     (best, tmax)
