@@ -24,20 +24,21 @@ use rayon::prelude::*;
 
 /// Largest mesh (triangles) that stores a shading frame per triangle (48 bytes each, 12 MB at most).
 pub const MAX_FACE_FRAMES: usize = 1 << 18;
-/// Largest mesh (triangles) that stores its triangles for area sampling (72 bytes each, 1.2 MB at
-/// most): area lights are rectangles, cubes and small meshes; larger ones read the vertex arrays.
+/// Largest mesh (triangles) that stores its triangles for area sampling (64 bytes each, and 24 more
+/// for the corner uvs of a mesh with uvs: 1.4 MB at most): area lights are rectangles, cubes and
+/// small meshes; larger ones read the vertex arrays.
 pub const MAX_SAMPLE_TRIANGLES: usize = 1 << 14;
 
-/// What sampling a point on one triangle reads, in one place: a corner, the two edges leaving it,
-/// the normal (flipped with `flip_normals`) and the corners' uvs (`(0,0) (1,0) (0,1)` without uvs,
-/// so that uv = (b1, b2)).
+/// What sampling a point on one triangle reads, in one place: a corner, the two edges leaving it
+/// and the normal (flipped with `flip_normals`), in 16-byte vectors (four aligned loads; the
+/// point `p0 + e0 b1 + e1 b2` is the same per-lane arithmetic as in `Vec3`, so the same bits).
+/// The corners' uvs are apart (`Mesh::sample_uvs`): only a textured emitter reads them.
 #[derive(Clone, Copy, Debug)]
 struct SampleTriangle {
-    p0: Vec3,
-    e0: Vec3,
-    e1: Vec3,
-    n: Vec3,
-    uv: [Vec2; 3],
+    p0: Vec3A,
+    e0: Vec3A,
+    e1: Vec3A,
+    n: Vec3A,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -62,8 +63,18 @@ pub struct Mesh {
     face_frames: Vec<[Vec3A; 3]>,
     /// Per triangle, what area sampling reads (meshes up to [`MAX_SAMPLE_TRIANGLES`]; else empty).
     sample_triangles: Vec<SampleTriangle>,
+    /// Per triangle, the corners' uvs, for meshes with uvs up to [`MAX_SAMPLE_TRIANGLES`]
+    /// triangles (else empty: read through the indices).
+    sample_uvs: Vec<[Vec2; 3]>,
     /// Triangles by area (alias table, for area sampling).
     area_distr: Distribution1D,
+    /// `1 / surface_area()`: the area density of [`Mesh::sample_position`], the same division
+    /// done once.
+    inv_area: f32,
+    /// Whether points sampled on the mesh need their uv: cleared by the scene when the mesh is an
+    /// area emitter of constant radiance (nothing then reads it); `sample_position` then leaves uv
+    /// zero.
+    pub sample_uv: bool,
     /// Whether hits need their uv: cleared by the scene when neither the shape's BSDF nor its area
     /// emitter reads a spatially varying texture; `interaction` then leaves uv zero instead of
     /// interpolating it.
@@ -136,7 +147,10 @@ impl Mesh {
             face_dp_du,
             face_frames: Vec::new(),
             sample_triangles: Vec::new(),
+            sample_uvs: Vec::new(),
+            inv_area: 1.0 / (area_distr.sum() as f32),
             area_distr,
+            sample_uv: true,
             hit_uv: true,
             plane: None,
         };
@@ -144,6 +158,9 @@ impl Mesh {
         mesh.plane = mesh.flat_plane();
         if mesh.indices.len() <= MAX_SAMPLE_TRIANGLES {
             mesh.sample_triangles = (0..mesh.indices.len() as u32).map(|prim| mesh.sample_triangle(prim)).collect();
+            if !mesh.uvs.is_empty() {
+                mesh.sample_uvs = mesh.indices.iter().map(|idx| idx.map(|i| mesh.uvs[i as usize])).collect();
+            }
         }
         mesh
     }
@@ -268,14 +285,12 @@ impl Mesh {
         (p0 * b0 + p1 * b1 + p2 * b2, if self.flip_normals { -face_n } else { face_n })
     }
 
-    /// The corner, edges, normal and corner uvs of triangle `prim` (see [`SampleTriangle`]).
+    /// The corner, edges and normal of triangle `prim` (see [`SampleTriangle`]).
     #[inline(always)]
     fn sample_triangle(&self, prim: u32) -> SampleTriangle {
-        let idx = self.indices[prim as usize];
-        let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
-        let n = self.face_normals[prim as usize];
-        let uv = if self.uvs.is_empty() { [Vec2::ZERO, Vec2::X, Vec2::Y] } else { idx.map(|i| self.uvs[i as usize]) };
-        SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: if self.flip_normals { -n } else { n }, uv }
+        let [p0, p1, p2] = self.indices[prim as usize].map(|i| Vec3A::from(self.positions[i as usize]));
+        let n = Vec3A::from(self.face_normals[prim as usize]);
+        SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: if self.flip_normals { -n } else { n } }
     }
 
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
@@ -320,21 +335,37 @@ impl Mesh {
     }
 
     /// Uniform by area: pick a triangle by area, then a uniform point on it, `p0 + e0 b1 + e1 b2`
-    /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges).
+    /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges). The
+    /// uv is interpolated from the corners' uvs (`(0,0) (1,0) (0,1)` without uvs: exactly
+    /// (b1, b2)), or left zero where nothing reads it (`sample_uv`).
     #[inline(always)]
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
-        let total = self.surface_area();
         // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf).
         let (prim, sx, _) = self.area_distr.sample(sample.x).unwrap_or((0, 0.5, 0.0));
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
+        let computed;
         let tri = match self.sample_triangles.get(prim) {
-            Some(tri) => *tri,
-            None => self.sample_triangle(prim as u32),
+            Some(tri) => tri,
+            None => {
+                computed = self.sample_triangle(prim as u32);
+                &computed
+            }
         };
         let p = tri.p0 + tri.e0 * b.x + tri.e1 * b.y;
-        // (0,0) (1,0) (0,1) without uvs: exactly (b1, b2).
-        let uv = tri.uv[0] * (1.0 - b.x - b.y) + tri.uv[1] * b.x + tri.uv[2] * b.y;
-        PositionSample { p, n: tri.n, uv, pdf: 1.0 / total }
+        let uv = if !self.sample_uv {
+            Vec2::ZERO
+        } else if self.uvs.is_empty() {
+            // (0,0) (1,0) (0,1) interpolated: 0 w + 1 b1 + 0 b2 = b1 and 0 w + 0 b1 + 1 b2 = b2
+            // exactly (w, b1, b2 are non-negative, so each zero product is +0).
+            b
+        } else {
+            let uv = match self.sample_uvs.get(prim) {
+                Some(uv) => *uv,
+                None => self.indices[prim].map(|i| self.uvs[i as usize]),
+            };
+            uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y
+        };
+        PositionSample { p: p.into(), n: tri.n.into(), uv, pdf: self.inv_area }
     }
 }
 
