@@ -170,6 +170,7 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         surfaces_block_shadow_rays: false,
         only_area_emitters: false,
         constant_sphere_lights: Vec::new(),
+        ray_avx2: super::world::ray_avx2_supported(),
     };
     scene.only_area_emitters =
         !scene.emitters.is_empty() && scene.emitters.iter().all(|e| matches!(e, SceneEmitter::Area { .. }));
