@@ -50,10 +50,13 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     pub indices: Vec<[u32; 3]>,
     pub flip_normals: bool,
-    /// Unit face normal per triangle from the winding, before `flip_normals` (zero if degenerate).
+    /// Unit face normal per triangle from the winding, flipped with `flip_normals` (zero if
+    /// degenerate): the geometric normal of every hit and sample on the triangle, negated once at
+    /// load instead of at each of them.
     pub face_normals: Vec<Vec3>,
-    /// dp/du of each triangle's uv parametrisation (zero where the uv triangle is degenerate);
-    /// empty when the mesh has no uvs (then dp/du = p1 − p0 of the barycentric uv).
+    /// dp/du of each triangle's uv parametrisation, or where the uv triangle is degenerate the
+    /// first vector of `coordinate_system(face normal before flip_normals)` (both resolved at
+    /// load); empty when the mesh has no uvs (then dp/du = p1 − p0 of the barycentric uv).
     pub face_dp_du: Vec<Vec3>,
     /// The shading frame of each triangle when it is the same at every point of every triangle
     /// (no vertex normals, or the three vertex normals of each triangle equal, as on `rectangle`,
@@ -113,8 +116,18 @@ impl Mesh {
                 (c.normalize_or_zero(), 0.5 * c.length())
             })
             .unzip();
-        let face_dp_du =
-            if data.uvs.is_empty() { Vec::new() } else { uv_tangents(&positions, &data.uvs, &data.indices) };
+        let face_dp_du = if data.uvs.is_empty() {
+            Vec::new()
+        } else {
+            let mut dp_du = uv_tangents(&positions, &data.uvs, &data.indices);
+            // A degenerate uv triangle: coordinate_system(face normal before flipping).
+            dp_du.par_iter_mut().zip(&face_n).for_each(|(d, &n)| {
+                if *d == Vec3::ZERO {
+                    *d = Frame::from_normal(n).s;
+                }
+            });
+            dp_du
+        };
         let vertex_normals = || {
             if face_normals {
                 Vec::new()
@@ -137,6 +150,7 @@ impl Mesh {
             }
         };
         let (normals, area_distr) = rayon::join(vertex_normals, || Distribution1D::new(&areas));
+        let face_n = if flip_normals { face_n.par_iter().map(|&n| -n).collect() } else { face_n };
         let mut mesh = Mesh {
             positions,
             normals,
@@ -169,20 +183,13 @@ impl Mesh {
     /// constant over the triangle.
     #[inline(always)]
     fn normal_and_dp_du(&self, prim: u32) -> (Vec3, Vec3) {
-        let face_n = self.face_normals[prim as usize];
-        let n = if self.flip_normals { -face_n } else { face_n };
+        let n = self.face_normals[prim as usize];
         let dp_du = if self.uvs.is_empty() {
             // uv = (b1, b2): dp/du = p1 − p0.
             let idx = self.indices[prim as usize];
             self.positions[idx[1] as usize] - self.positions[idx[0] as usize]
         } else {
-            let dp_du = self.face_dp_du[prim as usize];
-            // A degenerate uv triangle: coordinate_system(face normal before flipping).
-            if dp_du == Vec3::ZERO {
-                Frame::from_normal(face_n).s
-            } else {
-                dp_du
-            }
+            self.face_dp_du[prim as usize]
         };
         (n, dp_du)
     }
@@ -236,11 +243,11 @@ impl Mesh {
         if self.indices.len() > MAX_SAMPLE_TRIANGLES {
             return None;
         }
-        let n0 = *self.face_normals.first()?;
-        if !(n0.length_squared() > 0.5) || self.face_normals.iter().any(|n| !((*n - n0).length() <= 1e-5)) {
+        // (Flipped or not, the normals' differences have the same lengths.)
+        let n = *self.face_normals.first()?;
+        if !(n.length_squared() > 0.5) || self.face_normals.iter().any(|m| !((*m - n).length() <= 1e-5)) {
             return None;
         }
-        let n = if self.flip_normals { -n0 } else { n0 };
         let vertices = || self.indices.iter().flatten().map(|&i| self.positions[i as usize]);
         let c = n.dot(vertices().next()?);
         let scale = 1.0 + vertices().map(|p| p.abs().max_element()).fold(0.0, f32::max);
@@ -281,16 +288,14 @@ impl Mesh {
     pub fn point_and_normal(&self, prim: u32, b1: f32, b2: f32) -> (Vec3, Vec3) {
         let [p0, p1, p2] = self.indices[prim as usize].map(|i| self.positions[i as usize]);
         let b0 = 1.0 - b1 - b2;
-        let face_n = self.face_normals[prim as usize];
-        (p0 * b0 + p1 * b1 + p2 * b2, if self.flip_normals { -face_n } else { face_n })
+        (p0 * b0 + p1 * b1 + p2 * b2, self.face_normals[prim as usize])
     }
 
     /// The corner, edges and normal of triangle `prim` (see [`SampleTriangle`]).
     #[inline(always)]
     fn sample_triangle(&self, prim: u32) -> SampleTriangle {
         let [p0, p1, p2] = self.indices[prim as usize].map(|i| Vec3A::from(self.positions[i as usize]));
-        let n = Vec3A::from(self.face_normals[prim as usize]);
-        SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: if self.flip_normals { -n } else { n } }
+        SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: self.face_normals[prim as usize].into() }
     }
 
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
@@ -304,8 +309,7 @@ impl Mesh {
         let [p0, p1, p2] = idx.map(|i| Vec3A::from(self.positions[i as usize]));
         let b0 = 1.0 - b1 - b2;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let face_n = self.face_normals[prim as usize];
-        let n = if self.flip_normals { -face_n } else { face_n };
+        let n = self.face_normals[prim as usize];
         let uv = if !self.hit_uv {
             Vec2::ZERO
         } else if self.uvs.is_empty() {
@@ -318,12 +322,7 @@ impl Mesh {
             Some(frame) => *frame,
             None => {
                 // dp/du as `normal_and_dp_du` computes it.
-                let dp_du = if self.uvs.is_empty() {
-                    p1 - p0
-                } else {
-                    let dp_du = self.face_dp_du[prim as usize];
-                    Vec3A::from(if dp_du == Vec3::ZERO { Frame::from_normal(face_n).s } else { dp_du })
-                };
+                let dp_du = if self.uvs.is_empty() { p1 - p0 } else { Vec3A::from(self.face_dp_du[prim as usize]) };
                 shading_frame_a(self.shading_normal(idx, n.into(), b0, b1, b2), dp_du)
             }
         };
@@ -512,12 +511,22 @@ mod tests {
                 let [p0, p1, p2] = idx.map(|i| mesh.positions[i as usize]);
                 let b0 = 1.0 - b1 - b2;
                 let p = p0 * b0 + p1 * b1 + p2 * b2;
-                let face_n = mesh.face_normals[prim as usize];
+                // The face normal from the winding, then flipped; dp/du from the uvs (the
+                // coordinate system of the unflipped normal where the uv triangle is degenerate).
+                let face_n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
                 let n = if flip { -face_n } else { face_n };
-                let dp_du = match mesh.face_dp_du.get(prim as usize) {
-                    None => p1 - p0,
-                    Some(&dp_du) if dp_du == Vec3::ZERO => Frame::from_normal(face_n).s,
-                    Some(&dp_du) => dp_du,
+                let dp_du = if uvs {
+                    let [u0, u1, u2] = idx.map(|i| mesh.uvs[i as usize]);
+                    let (duv0, duv1) = (u1 - u0, u2 - u0);
+                    let det = duv0.x * duv1.y - duv0.y * duv1.x;
+                    let dp_du = ((p1 - p0) * duv1.y - (p2 - p0) * duv0.y) / det;
+                    if det != 0.0 && dp_du.is_finite() {
+                        dp_du
+                    } else {
+                        Frame::from_normal(face_n).s
+                    }
+                } else {
+                    p1 - p0
                 };
                 let sh_n = if mesh.normals.is_empty() {
                     n
