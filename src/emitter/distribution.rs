@@ -21,6 +21,8 @@ pub struct Distribution1D {
     table: Vec<(f32, u32)>,
     /// Sum of the weights.
     sum: f64,
+    /// The table's length as `f32` (the conversion done once).
+    n_f: f32,
 }
 
 impl Distribution1D {
@@ -35,10 +37,10 @@ impl Distribution1D {
             })
             .sum();
         if acc <= 0.0 {
-            return Distribution1D { pmf: vec![0.0; weights.len()], table: Vec::new(), sum: acc };
+            return Distribution1D { pmf: vec![0.0; weights.len()], table: Vec::new(), sum: acc, n_f: 0.0 };
         }
         let pmf = weights.iter().map(|&w| (w.max(0.0) as f64 / acc) as f32).collect();
-        Distribution1D { pmf, table: alias_table(weights, acc), sum: acc }
+        Distribution1D { pmf, table: alias_table(weights, acc), sum: acc, n_f: weights.len() as f32 }
     }
 
     /// Number of bins.
@@ -75,7 +77,7 @@ impl Distribution1D {
             return None;
         }
         let n = self.table.len();
-        let x = u.clamp(0.0, 1.0) * n as f32;
+        let x = u.clamp(0.0, 1.0) * self.n_f;
         // Through u32 (bins are indexed by u32): a cheaper saturating conversion, the same index.
         let slot = (x as u32 as usize).min(n - 1);
         // Below 1, so a slot that keeps all of its bin (keep = 1) always keeps it.

@@ -59,6 +59,14 @@ pub struct EnvironmentEmitter {
     distr: Arc<Distribution2D>,
     /// cos θ of each row of texel centres (`height` entries, 1 down to −1).
     cos_theta: Arc<[f32]>,
+    /// Solid angle of the cells in each row of the sampling grid (`height − 1` entries:
+    /// [`EnvironmentEmitter::cell_solid_angle`] computed once, with the same operations).
+    omega: Arc<[f32]>,
+    /// `width` and `height − 1` as `f32`, and half a texel in u (`0.5 / width`): constants of
+    /// every lookup, converted and divided once.
+    width_f: f32,
+    rows_f: f32,
+    half_texel: f32,
     pub bsphere: BoundingSphere,
 }
 
@@ -161,6 +169,8 @@ impl EnvironmentEmitter {
         }
         let distr = Distribution2D::new(&weights, width, height - 1);
         let to_local = to_world.inverse();
+        let width_f = width as f32;
+        let omega: Vec<f32> = (0..height - 1).map(|j| 2.0 * PI / width_f * (cos_theta[j] - cos_theta[j + 1])).collect();
         Ok(EnvironmentEmitter {
             filename,
             width,
@@ -171,6 +181,10 @@ impl EnvironmentEmitter {
             to_local,
             distr: Arc::new(distr),
             cos_theta: cos_theta.into(),
+            omega: omega.into(),
+            width_f,
+            rows_f: (height - 1) as f32,
+            half_texel: 0.5 / width_f,
             bsphere: BoundingSphere::default(),
         })
     }
@@ -178,7 +192,7 @@ impl EnvironmentEmitter {
     /// Half a texel in u: the shift between the map's texel centres and the sampling grid.
     #[inline]
     fn half_texel(&self) -> f32 {
-        0.5 / self.width as f32
+        self.half_texel
     }
 
     /// Mitsuba's latitude-longitude coordinates of a local direction.
@@ -192,9 +206,9 @@ impl EnvironmentEmitter {
     #[inline]
     pub fn eval_uv(&self, uv: Vec2) -> Spectrum {
         let (w, h) = (self.width, self.height);
-        let uv = Vec2::new(fast::fract(uv.x - self.half_texel()), fast::fract(uv.y));
-        let x = uv.x * w as f32;
-        let y = uv.y * (h - 1) as f32;
+        let uv = Vec2::new(fract_unit(uv.x - self.half_texel()), fract_unit(uv.y));
+        let x = uv.x * self.width_f;
+        let y = uv.y * self.rows_f;
         // Float → integer casts saturate (NaN → 0), so the indices stay in range; through u32
         // (a cheaper conversion than to usize, the same index: the map is narrower than 2^32).
         let px = (x as u32 as usize).min(w - 1);
@@ -222,15 +236,15 @@ impl EnvironmentEmitter {
     /// Solid angle of the cells in row `j` of the sampling grid.
     #[inline]
     fn cell_solid_angle(&self, j: usize) -> f32 {
-        2.0 * PI / self.width as f32 * (self.cos_theta[j] - self.cos_theta[j + 1])
+        self.omega[j]
     }
 
     /// The sampling cell that contains local direction `d`.
     #[inline]
     fn cell_of(&self, uv: Vec2) -> (usize, usize) {
         let u = uv.x - self.half_texel();
-        let x = fast::fract(u) * self.width as f32;
-        let y = uv.y.clamp(0.0, 1.0) * (self.height - 1) as f32;
+        let x = fract_unit(u) * self.width_f;
+        let y = uv.y.clamp(0.0, 1.0) * self.rows_f;
         ((x as u32 as usize).min(self.width - 1), (y as u32 as usize).min(self.height - 2))
     }
 
@@ -240,7 +254,7 @@ impl EnvironmentEmitter {
             return (DirectionSample::default(), Spectrum::ZERO);
         };
         // Uniform in solid angle within the cell: u linear, cos θ linear.
-        let mut u = (i as f32 + 0.5 + r.x) / self.width as f32;
+        let mut u = (i as f32 + 0.5 + r.x) / self.width_f;
         if u >= 1.0 {
             u -= 1.0;
         }
@@ -286,7 +300,7 @@ impl EnvironmentEmitter {
     }
 
     /// [`EnvironmentEmitter::pdf_direction`] at Mitsuba's uv of the local direction.
-    #[inline]
+    #[inline(always)]
     fn pdf_uv(&self, uv: Vec2) -> f32 {
         let (i, j) = self.cell_of(uv);
         let omega = self.cell_solid_angle(j);
@@ -308,6 +322,18 @@ impl std::fmt::Debug for EnvironmentEmitter {
             .field("to_world", &self.to_world)
             .field("bsphere", &self.bsphere)
             .finish_non_exhaustive()
+    }
+}
+
+/// [`fast::fract`] with its common case first: a value in [0, 1) is its own fractional part
+/// (`v − 0`, the same bits, −0 included), so only other values take the general path. The
+/// lookups' u and v are in [0, 1) nearly always.
+#[inline(always)]
+fn fract_unit(v: f32) -> f32 {
+    if (0.0..1.0).contains(&v) {
+        v
+    } else {
+        fast::fract(v)
     }
 }
 

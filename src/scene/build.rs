@@ -170,6 +170,7 @@ pub fn build_scene(parsed: &ParsedScene) -> Result<Scene> {
         surfaces_block_shadow_rays: false,
         only_area_emitters: false,
         constant_sphere_lights: Vec::new(),
+        ray_avx2: super::world::ray_avx2_supported(),
     };
     scene.only_area_emitters =
         !scene.emitters.is_empty() && scene.emitters.iter().all(|e| matches!(e, SceneEmitter::Area { .. }));
@@ -276,9 +277,11 @@ impl Builder<'_> {
                 ));
             }
             let radiance = crate::emitter::area::from_desc(&e, self.resolver)?;
-            if let Geometry::Sphere(s) = &mut geometry {
-                // Light samples need the sphere's uv (acos, atan2) only for a textured radiance.
-                s.sample_uv = radiance.is_spatially_varying();
+            // Light samples need the uv (the sphere's: acos, atan2) only for a textured radiance.
+            match &mut geometry {
+                Geometry::Sphere(s) => s.sample_uv = radiance.is_spatially_varying(),
+                Geometry::Mesh(m) => m.sample_uv = radiance.is_spatially_varying(),
+                Geometry::Disk(_) => {}
             }
             self.emitters.push(SceneEmitter::Area { shape: index, radiance });
             emitter = Some((self.emitters.len() - 1) as u32);

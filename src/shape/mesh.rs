@@ -25,20 +25,21 @@ use rayon::prelude::*;
 
 /// Largest mesh (triangles) that stores a shading frame per triangle (48 bytes each, 12 MB at most).
 pub const MAX_FACE_FRAMES: usize = 1 << 18;
-/// Largest mesh (triangles) that stores its triangles for area sampling (72 bytes each, 1.2 MB at
-/// most): area lights are rectangles, cubes and small meshes; larger ones read the vertex arrays.
+/// Largest mesh (triangles) that stores its triangles for area sampling (64 bytes each, and 24 more
+/// for the corner uvs of a mesh with uvs: 1.4 MB at most): area lights are rectangles, cubes and
+/// small meshes; larger ones read the vertex arrays.
 pub const MAX_SAMPLE_TRIANGLES: usize = 1 << 14;
 
-/// What sampling a point on one triangle reads, in one place: a corner, the two edges leaving it,
-/// the normal (flipped with `flip_normals`) and the corners' uvs (`(0,0) (1,0) (0,1)` without uvs,
-/// so that uv = (b1, b2)).
+/// What sampling a point on one triangle reads, in one place: a corner, the two edges leaving it
+/// and the normal (flipped with `flip_normals`), in 16-byte vectors (four aligned loads; the
+/// point `p0 + e0 b1 + e1 b2` is the same per-lane arithmetic as in `Vec3`, so the same bits).
+/// The corners' uvs are apart (`Mesh::sample_uvs`): only a textured emitter reads them.
 #[derive(Clone, Copy, Debug)]
 struct SampleTriangle {
-    p0: Vec3,
-    e0: Vec3,
-    e1: Vec3,
-    n: Vec3,
-    uv: [Vec2; 3],
+    p0: Vec3A,
+    e0: Vec3A,
+    e1: Vec3A,
+    n: Vec3A,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -50,10 +51,13 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     pub indices: Vec<[u32; 3]>,
     pub flip_normals: bool,
-    /// Unit face normal per triangle from the winding, before `flip_normals` (zero if degenerate).
+    /// Unit face normal per triangle from the winding, flipped with `flip_normals` (zero if
+    /// degenerate): the geometric normal of every hit and sample on the triangle, negated once at
+    /// load instead of at each of them.
     pub face_normals: Vec<Vec3>,
-    /// dp/du of each triangle's uv parametrisation (zero where the uv triangle is degenerate);
-    /// empty when the mesh has no uvs (then dp/du = p1 − p0 of the barycentric uv).
+    /// dp/du of each triangle's uv parametrisation, or where the uv triangle is degenerate the
+    /// first vector of `coordinate_system(face normal before flip_normals)` (both resolved at
+    /// load); empty when the mesh has no uvs (then dp/du = p1 − p0 of the barycentric uv).
     pub face_dp_du: Vec<Vec3>,
     /// The shading frame of each triangle when it is the same at every point of every triangle
     /// (no vertex normals, or the three vertex normals of each triangle equal, as on `rectangle`,
@@ -63,8 +67,18 @@ pub struct Mesh {
     face_frames: Vec<[Vec3A; 3]>,
     /// Per triangle, what area sampling reads (meshes up to [`MAX_SAMPLE_TRIANGLES`]; else empty).
     sample_triangles: Vec<SampleTriangle>,
+    /// Per triangle, the corners' uvs, for meshes with uvs up to [`MAX_SAMPLE_TRIANGLES`]
+    /// triangles (else empty: read through the indices).
+    sample_uvs: Vec<[Vec2; 3]>,
     /// Triangles by area (alias table, for area sampling).
     area_distr: Distribution1D,
+    /// `1 / surface_area()`: the area density of [`Mesh::sample_position`], the same division
+    /// done once.
+    inv_area: f32,
+    /// Whether points sampled on the mesh need their uv: cleared by the scene when the mesh is an
+    /// area emitter of constant radiance (nothing then reads it); `sample_position` then leaves uv
+    /// zero.
+    pub sample_uv: bool,
     /// Whether hits need their uv: cleared by the scene when neither the shape's BSDF nor its area
     /// emitter reads a spatially varying texture; `interaction` then leaves uv zero instead of
     /// interpolating it.
@@ -103,8 +117,18 @@ impl Mesh {
                 (c.normalize_or_zero(), 0.5 * c.length())
             })
             .unzip();
-        let face_dp_du =
-            if data.uvs.is_empty() { Vec::new() } else { uv_tangents(&positions, &data.uvs, &data.indices) };
+        let face_dp_du = if data.uvs.is_empty() {
+            Vec::new()
+        } else {
+            let mut dp_du = uv_tangents(&positions, &data.uvs, &data.indices);
+            // A degenerate uv triangle: coordinate_system(face normal before flipping).
+            dp_du.par_iter_mut().zip(&face_n).for_each(|(d, &n)| {
+                if *d == Vec3::ZERO {
+                    *d = Frame::from_normal(n).s;
+                }
+            });
+            dp_du
+        };
         let vertex_normals = || {
             if face_normals {
                 Vec::new()
@@ -127,6 +151,7 @@ impl Mesh {
             }
         };
         let (normals, area_distr) = rayon::join(vertex_normals, || Distribution1D::new(&areas));
+        let face_n = if flip_normals { face_n.par_iter().map(|&n| -n).collect() } else { face_n };
         let mut mesh = Mesh {
             positions,
             normals,
@@ -137,7 +162,10 @@ impl Mesh {
             face_dp_du,
             face_frames: Vec::new(),
             sample_triangles: Vec::new(),
+            sample_uvs: Vec::new(),
+            inv_area: 1.0 / (area_distr.sum() as f32),
             area_distr,
+            sample_uv: true,
             hit_uv: true,
             plane: None,
         };
@@ -145,6 +173,9 @@ impl Mesh {
         mesh.plane = mesh.flat_plane();
         if mesh.indices.len() <= MAX_SAMPLE_TRIANGLES {
             mesh.sample_triangles = (0..mesh.indices.len() as u32).map(|prim| mesh.sample_triangle(prim)).collect();
+            if !mesh.uvs.is_empty() {
+                mesh.sample_uvs = mesh.indices.iter().map(|idx| idx.map(|i| mesh.uvs[i as usize])).collect();
+            }
         }
         mesh
     }
@@ -153,20 +184,13 @@ impl Mesh {
     /// constant over the triangle.
     #[inline(always)]
     fn normal_and_dp_du(&self, prim: u32) -> (Vec3, Vec3) {
-        let face_n = self.face_normals[prim as usize];
-        let n = if self.flip_normals { -face_n } else { face_n };
+        let n = self.face_normals[prim as usize];
         let dp_du = if self.uvs.is_empty() {
             // uv = (b1, b2): dp/du = p1 − p0.
             let idx = self.indices[prim as usize];
             self.positions[idx[1] as usize] - self.positions[idx[0] as usize]
         } else {
-            let dp_du = self.face_dp_du[prim as usize];
-            // A degenerate uv triangle: coordinate_system(face normal before flipping).
-            if dp_du == Vec3::ZERO {
-                Frame::from_normal(face_n).s
-            } else {
-                dp_du
-            }
+            self.face_dp_du[prim as usize]
         };
         (n, dp_du)
     }
@@ -234,11 +258,11 @@ impl Mesh {
         if self.indices.len() > MAX_SAMPLE_TRIANGLES {
             return None;
         }
-        let n0 = *self.face_normals.first()?;
-        if !(n0.length_squared() > 0.5) || self.face_normals.iter().any(|n| !((*n - n0).length() <= 1e-5)) {
+        // (Flipped or not, the normals' differences have the same lengths.)
+        let n = *self.face_normals.first()?;
+        if !(n.length_squared() > 0.5) || self.face_normals.iter().any(|m| !((*m - n).length() <= 1e-5)) {
             return None;
         }
-        let n = if self.flip_normals { -n0 } else { n0 };
         let vertices = || self.indices.iter().flatten().map(|&i| self.positions[i as usize]);
         let c = n.dot(vertices().next()?);
         let scale = 1.0 + vertices().map(|p| p.abs().max_element()).fold(0.0, f32::max);
@@ -279,18 +303,14 @@ impl Mesh {
     pub fn point_and_normal(&self, prim: u32, b1: f32, b2: f32) -> (Vec3, Vec3) {
         let [p0, p1, p2] = self.indices[prim as usize].map(|i| self.positions[i as usize]);
         let b0 = 1.0 - b1 - b2;
-        let face_n = self.face_normals[prim as usize];
-        (p0 * b0 + p1 * b1 + p2 * b2, if self.flip_normals { -face_n } else { face_n })
+        (p0 * b0 + p1 * b1 + p2 * b2, self.face_normals[prim as usize])
     }
 
-    /// The corner, edges, normal and corner uvs of triangle `prim` (see [`SampleTriangle`]).
+    /// The corner, edges and normal of triangle `prim` (see [`SampleTriangle`]).
     #[inline(always)]
     fn sample_triangle(&self, prim: u32) -> SampleTriangle {
-        let idx = self.indices[prim as usize];
-        let [p0, p1, p2] = idx.map(|i| self.positions[i as usize]);
-        let n = self.face_normals[prim as usize];
-        let uv = if self.uvs.is_empty() { [Vec2::ZERO, Vec2::X, Vec2::Y] } else { idx.map(|i| self.uvs[i as usize]) };
-        SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: if self.flip_normals { -n } else { n }, uv }
+        let [p0, p1, p2] = self.indices[prim as usize].map(|i| Vec3A::from(self.positions[i as usize]));
+        SampleTriangle { p0, e0: p1 - p0, e1: p2 - p0, n: self.face_normals[prim as usize].into() }
     }
 
     /// Fill a surface interaction for a hit on triangle `prim` at barycentrics (b1, b2).
@@ -332,8 +352,8 @@ impl Mesh {
         LaneShade { shape, prim, n, face_n: self.face_normals[prim as usize] }
     }
 
-    /// The hit record of triangle `prim` with vertices `v`, face normal `face_n` (before
-    /// `flip_normals`) and vertex normals from `vertex_normals`, at barycentrics `(b1, b2)` and distance `t`.
+    /// The hit record of triangle `prim` with vertices `v`, face normal `face_n` (flipped with
+    /// `flip_normals`, as `face_normals` holds it) and vertex normals from `vertex_normals`, at barycentrics `(b1, b2)` and distance `t`.
     #[inline(always)]
     fn interaction_with(
         &self,
@@ -346,7 +366,7 @@ impl Mesh {
     ) -> SurfaceInteraction {
         let b0 = 1.0 - b1 - b2;
         let p = p0 * b0 + p1 * b1 + p2 * b2;
-        let n = if self.flip_normals { -face_n } else { face_n };
+        let n = face_n;
         let uv = if !self.hit_uv {
             Vec2::ZERO
         } else if self.uvs.is_empty() {
@@ -359,12 +379,7 @@ impl Mesh {
             Some(frame) => *frame,
             None => {
                 // dp/du as `normal_and_dp_du` computes it.
-                let dp_du = if self.uvs.is_empty() {
-                    p1 - p0
-                } else {
-                    let dp_du = self.face_dp_du[prim as usize];
-                    Vec3A::from(if dp_du == Vec3::ZERO { Frame::from_normal(face_n).s } else { dp_du })
-                };
+                let dp_du = if self.uvs.is_empty() { p1 - p0 } else { Vec3A::from(self.face_dp_du[prim as usize]) };
                 shading_frame_a(self.shading_normal_from(vertex_normals, n.into(), b0, b1, b2), dp_du)
             }
         };
@@ -376,21 +391,37 @@ impl Mesh {
     }
 
     /// Uniform by area: pick a triangle by area, then a uniform point on it, `p0 + e0 b1 + e1 b2`
-    /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges).
+    /// as Mitsuba's `Mesh::sample_position` computes it (from the corner and the two edges). The
+    /// uv is interpolated from the corners' uvs (`(0,0) (1,0) (0,1)` without uvs: exactly
+    /// (b1, b2)), or left zero where nothing reads it (`sample_uv`).
     #[inline(always)]
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
-        let total = self.surface_area();
         // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf).
         let (prim, sx, _) = self.area_distr.sample(sample.x).unwrap_or((0, 0.5, 0.0));
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
+        let computed;
         let tri = match self.sample_triangles.get(prim) {
-            Some(tri) => *tri,
-            None => self.sample_triangle(prim as u32),
+            Some(tri) => tri,
+            None => {
+                computed = self.sample_triangle(prim as u32);
+                &computed
+            }
         };
         let p = tri.p0 + tri.e0 * b.x + tri.e1 * b.y;
-        // (0,0) (1,0) (0,1) without uvs: exactly (b1, b2).
-        let uv = tri.uv[0] * (1.0 - b.x - b.y) + tri.uv[1] * b.x + tri.uv[2] * b.y;
-        PositionSample { p, n: tri.n, uv, pdf: 1.0 / total }
+        let uv = if !self.sample_uv {
+            Vec2::ZERO
+        } else if self.uvs.is_empty() {
+            // (0,0) (1,0) (0,1) interpolated: 0 w + 1 b1 + 0 b2 = b1 and 0 w + 0 b1 + 1 b2 = b2
+            // exactly (w, b1, b2 are non-negative, so each zero product is +0).
+            b
+        } else {
+            let uv = match self.sample_uvs.get(prim) {
+                Some(uv) => *uv,
+                None => self.indices[prim].map(|i| self.uvs[i as usize]),
+            };
+            uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y
+        };
+        PositionSample { p: p.into(), n: tri.n.into(), uv, pdf: self.inv_area }
     }
 }
 
@@ -537,12 +568,22 @@ mod tests {
                 let [p0, p1, p2] = idx.map(|i| mesh.positions[i as usize]);
                 let b0 = 1.0 - b1 - b2;
                 let p = p0 * b0 + p1 * b1 + p2 * b2;
-                let face_n = mesh.face_normals[prim as usize];
+                // The face normal from the winding, then flipped; dp/du from the uvs (the
+                // coordinate system of the unflipped normal where the uv triangle is degenerate).
+                let face_n = (p1 - p0).cross(p2 - p0).normalize_or_zero();
                 let n = if flip { -face_n } else { face_n };
-                let dp_du = match mesh.face_dp_du.get(prim as usize) {
-                    None => p1 - p0,
-                    Some(&dp_du) if dp_du == Vec3::ZERO => Frame::from_normal(face_n).s,
-                    Some(&dp_du) => dp_du,
+                let dp_du = if uvs {
+                    let [u0, u1, u2] = idx.map(|i| mesh.uvs[i as usize]);
+                    let (duv0, duv1) = (u1 - u0, u2 - u0);
+                    let det = duv0.x * duv1.y - duv0.y * duv1.x;
+                    let dp_du = ((p1 - p0) * duv1.y - (p2 - p0) * duv0.y) / det;
+                    if det != 0.0 && dp_du.is_finite() {
+                        dp_du
+                    } else {
+                        Frame::from_normal(face_n).s
+                    }
+                } else {
+                    p1 - p0
                 };
                 let sh_n = if mesh.normals.is_empty() {
                     n
