@@ -13,11 +13,40 @@
 //! `DIR/<scene>.rays` (little-endian `f32`, per ray o, d, tmax; the closest rays, then the shadow
 //! rays), so that another renderer can trace the same ones (`scripts/embree_rays.py` times Mitsuba
 //! 3's Embree on them).
+//!
+//! Each rate is the best of `--reps` runs, timed both on the wall clock and, on Linux, by the
+//! thread's own CPU time (`CLOCK_THREAD_CPUTIME_ID`), which leaves out the time other
+//! processes hold the core: on a shared machine it is the steadier of the two. `SNEE_ISA=avx2`
+//! (or `portable`) runs a lower traversal path than the CPU supports (see `shape::accel::Isa`).
 
 use snee::interaction::{offset_origin, spawn_ray_between};
 use snee::math::{warp, Frame, Ray};
 use snee::sampler::Sampler;
 use std::time::Instant;
+
+/// Nanoseconds the calling thread has run on a CPU (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`, from
+/// the C library std links), on Linux.
+#[cfg(target_os = "linux")]
+fn thread_cpu_ns() -> Option<u64> {
+    #[repr(C)]
+    struct Timespec {
+        sec: i64,
+        nsec: i64,
+    }
+    extern "C" {
+        fn clock_gettime(clock: i32, ts: *mut Timespec) -> i32;
+    }
+    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
+    let mut ts = Timespec { sec: 0, nsec: 0 };
+    // SAFETY: `ts` is a valid `struct timespec` (64-bit fields on the 64-bit Linux targets).
+    (unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0)
+        .then(|| ts.sec as u64 * 1_000_000_000 + ts.nsec as u64)
+}
+
+#[cfg(not(target_os = "linux"))]
+fn thread_cpu_ns() -> Option<u64> {
+    None
+}
 
 fn main() {
     let mut scenes = Vec::new();
@@ -81,8 +110,10 @@ fn main() {
             }
         }
         let (mut best_c, mut best_s) = (f64::INFINITY, f64::INFINITY);
+        let (mut cpu_c, mut cpu_s) = (f64::INFINITY, f64::INFINITY);
         let (mut hits, mut blocked, mut checksum) = (0usize, 0usize, 0.0f64);
         for _ in 0..reps {
+            let c0 = thread_cpu_ns();
             let t0 = Instant::now();
             hits = 0;
             checksum = 0.0;
@@ -93,20 +124,28 @@ fn main() {
                 }
             }
             let t1 = Instant::now();
+            let c1 = thread_cpu_ns();
             blocked = shadow.iter().filter(|r| scene.accel.occluded(shapes, r)).count();
             let t2 = Instant::now();
+            let c2 = thread_cpu_ns();
             best_c = best_c.min((t1 - t0).as_secs_f64());
             best_s = best_s.min((t2 - t1).as_secs_f64());
+            if let (Some(c0), Some(c1), Some(c2)) = (c0, c1, c2) {
+                cpu_c = cpu_c.min((c1 - c0) as f64 * 1e-9);
+                cpu_s = cpu_s.min((c2 - c1) as f64 * 1e-9);
+            }
         }
         let (mc, ms) = (n as f64 / best_c / 1e6, n as f64 / best_s / 1e6);
+        // CPU-time rates (wall-clock ones where the kernel gives no thread CPU time).
+        let (cc, cs) = if cpu_c.is_finite() { (n as f64 / cpu_c / 1e6, n as f64 / cpu_s / 1e6) } else { (mc, ms) };
         if json {
             out.push(format!(
-                "{{\"scene\": {path:?}, \"triangles\": {}, \"bytes_per_triangle\": {bytes_per_tri:.1}, \"load_s\": {load:.4}, \"closest_mrays\": {mc:.3}, \"shadow_mrays\": {ms:.3}, \"hits\": {hits}, \"blocked\": {blocked}}}",
+                "{{\"scene\": {path:?}, \"triangles\": {}, \"bytes_per_triangle\": {bytes_per_tri:.1}, \"load_s\": {load:.4}, \"closest_mrays\": {mc:.3}, \"shadow_mrays\": {ms:.3}, \"closest_mrays_cpu\": {cc:.3}, \"shadow_mrays_cpu\": {cs:.3}, \"hits\": {hits}, \"blocked\": {blocked}}}",
                 scene.triangle_count()
             ));
         } else {
             println!(
-                "{path}: {} triangles, load+build {load:.3} s; closest {mc:.2} Mrays/s ({hits} hits, sum t {checksum:.3}), shadow {ms:.2} Mrays/s ({blocked} blocked)",
+                "{path}: {} triangles, load+build {load:.3} s; closest {mc:.2} Mrays/s ({hits} hits, sum t {checksum:.3}), shadow {ms:.2} Mrays/s ({blocked} blocked); by CPU time closest {cc:.2}, shadow {cs:.2} Mrays/s",
                 scene.triangle_count()
             );
         }

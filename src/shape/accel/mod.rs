@@ -37,28 +37,70 @@ pub struct Hit {
 /// [`Hit::lane`] of a hit outside the BVH.
 pub const NO_LANE: u32 = u32::MAX;
 
-/// Which node test the CPU runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which node and leaf tests the CPU runs (ordered: each level needs the one below it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Isa {
     /// Two SSE halves (any x86-64 CPU, and other architectures through glam's fallback).
     Portable,
     /// One AVX register per plane, with BMI1 / LZCNT / POPCNT bit scans.
     Avx2,
+    /// The AVX2 tests with AVX-512VL: compares into mask registers, masked min / max and
+    /// compress in the ordering and the pushes, 32 vector registers (no spills in the leaf loop).
+    Avx512,
 }
 
 impl Isa {
     /// The best the running CPU supports.
     pub fn detect() -> Isa {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2")
-            && std::arch::is_x86_feature_detected!("bmi1")
-            && std::arch::is_x86_feature_detected!("lzcnt")
-            && std::arch::is_x86_feature_detected!("popcnt")
         {
-            return Isa::Avx2;
+            use std::arch::is_x86_feature_detected as has;
+            if has!("avx2") && has!("bmi1") && has!("lzcnt") && has!("popcnt") {
+                if has!("avx512f") && has!("avx512vl") && has!("avx512bw") && has!("avx512dq") {
+                    return Isa::Avx512;
+                }
+                return Isa::Avx2;
+            }
         }
         Isa::Portable
     }
+
+    /// What `Accel::build` uses: [`Isa::detect`], capped by the environment variable `SNEE_ISA`
+    /// (`portable`, `avx2` or `avx512`; for measuring one path against another on the same CPU).
+    /// A level the CPU lacks is never chosen.
+    pub fn selected() -> Isa {
+        let best = Isa::detect();
+        match std::env::var("SNEE_ISA").as_deref() {
+            Ok("portable") => Isa::Portable,
+            Ok("avx2") => best.min(Isa::Avx2),
+            _ => best,
+        }
+    }
+}
+
+/// The traversal `$avx512` / `$avx2` / `$portable` for `$isa`, with stack-entry prefetching when
+/// `$pf` (a const parameter of each, so each is compiled with and without it).
+macro_rules! dispatch {
+    ($isa:expr, $pf:expr, $avx512:ident, $avx2:ident, $portable:ident, ($($arg:expr),*)) => {{
+        let (isa, pf): (Isa, bool) = ($isa, $pf);
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `isa` is never above what the CPU supports (capped in `Accel::build_with`), and
+        // the tree and stack are as the traversals require (`build::build`, `traverse::stack_size`).
+        match (isa, pf) {
+            (Isa::Avx512, true) => return unsafe { traverse::$avx512::<true>($($arg),*) },
+            (Isa::Avx512, false) => return unsafe { traverse::$avx512::<false>($($arg),*) },
+            (Isa::Avx2, true) => return unsafe { traverse::$avx2::<true>($($arg),*) },
+            (Isa::Avx2, false) => return unsafe { traverse::$avx2::<false>($($arg),*) },
+            (Isa::Portable, _) => {}
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = isa;
+        if pf {
+            traverse::$portable::<true>($($arg),*)
+        } else {
+            traverse::$portable::<false>($($arg),*)
+        }
+    }};
 }
 
 pub struct Accel {
@@ -70,6 +112,8 @@ pub struct Accel {
     isa: Isa,
     /// The tree is too deep for the fixed traversal stack (`traverse::STACK`): queries use a heap one.
     deep: bool,
+    /// The tree is larger than `traverse::PREFETCH_BYTES`: traversals prefetch stack entries.
+    prefetch: bool,
 }
 
 /// A sphere tested outside the BVH: centre and r² (16-byte vectors: the test runs in SSE lanes).
@@ -82,13 +126,13 @@ struct AnalyticSphere {
 
 impl Accel {
     pub fn build(shapes: &[Shape]) -> Accel {
-        Self::build_with(shapes, Isa::detect())
+        Self::build_with(shapes, Isa::selected())
     }
 
-    /// Build with the given node-test ISA (`Isa::Avx2` falls back to `Isa::Portable` when the CPU
-    /// lacks it).
+    /// Build with the given node-test ISA (capped at what the CPU supports: `Isa::Avx512` falls
+    /// back to `Isa::Avx2`, and that to `Isa::Portable`).
     pub fn build_with(shapes: &[Shape], isa: Isa) -> Accel {
-        let isa = if isa == Isa::Avx2 && Isa::detect() != Isa::Avx2 { Isa::Portable } else { isa };
+        let isa = isa.min(Isa::detect());
         // Per mesh: (first builder index, shape index); the builder numbers the triangles of the
         // meshes one after another.
         let mut mesh_starts = Vec::new();
@@ -126,7 +170,8 @@ impl Accel {
             }
         });
         let deep = bvh.as_ref().is_some_and(|b| traverse::stack_size(b.depth) > STACK);
-        Accel { bvh, spheres, disks, isa, deep }
+        let prefetch = bvh.as_ref().is_some_and(|b| b.memory_bytes() > traverse::PREFETCH_BYTES);
+        Accel { bvh, spheres, disks, isa, deep, prefetch }
     }
 
     /// Bytes of the BVH (nodes, triangle packets, per-lane shape and triangle).
@@ -216,19 +261,14 @@ impl Accel {
     }
 
     /// The BVH's closest hit in (0, tmax): one call into the traversal compiled for the CPU (the
-    /// ray's precomputation happens inside it).
+    /// ray's precomputation happens inside it), prefetching stack entries in a large tree.
     #[inline(always)]
     fn closest(&self, bvh: &Bvh8, ray: &Ray, tmax: f32) -> Found {
         if self.deep {
             return closest_deep(bvh, ray, tmax, self.isa);
         }
         let stack = &mut [const { MaybeUninit::uninit() }; STACK];
-        #[cfg(target_arch = "x86_64")]
-        if self.isa == Isa::Avx2 {
-            // SAFETY: `Isa::Avx2` is only set when the CPU supports it (checked in `build_with`).
-            return unsafe { traverse::closest_avx2(bvh, ray, tmax, stack) };
-        }
-        traverse::closest_portable(bvh, ray, tmax, stack)
+        dispatch!(self.isa, self.prefetch, closest_avx512, closest_avx2, closest_portable, (bvh, ray, tmax, stack))
     }
 
     #[inline(always)]
@@ -237,12 +277,7 @@ impl Accel {
             return any_deep(bvh, ray, self.isa);
         }
         let stack = &mut [const { MaybeUninit::uninit() }; STACK];
-        #[cfg(target_arch = "x86_64")]
-        if self.isa == Isa::Avx2 {
-            // SAFETY: as in `closest`.
-            return unsafe { traverse::any_avx2(bvh, ray, stack) };
-        }
-        traverse::any_portable(bvh, ray, stack)
+        dispatch!(self.isa, self.prefetch, any_avx512, any_avx2, any_portable, (bvh, ray, stack))
     }
 }
 
@@ -257,18 +292,13 @@ fn bvh_hit(bvh: &Bvh8, found: Found) -> Option<Hit> {
     Some(Hit { shape: l.shape, prim: l.prim, b1, b2, t, lane })
 }
 
-/// Closest hit in a tree too deep for the fixed stack (a heap stack).
+/// Closest hit in a tree too deep for the fixed stack (a heap stack; such a tree is large, so
+/// its traversal prefetches).
 #[cold]
 #[inline(never)]
 fn closest_deep(bvh: &Bvh8, ray: &Ray, tmax: f32, isa: Isa) -> Found {
     let stack = &mut heap_stack(bvh.depth);
-    #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx2 {
-        // SAFETY: `Isa::Avx2` is only set when the CPU supports it.
-        return unsafe { traverse::closest_avx2(bvh, ray, tmax, stack) };
-    }
-    let _ = isa;
-    traverse::closest_portable(bvh, ray, tmax, stack)
+    dispatch!(isa, true, closest_avx512, closest_avx2, closest_portable, (bvh, ray, tmax, stack))
 }
 
 /// Any hit in a tree too deep for the fixed stack.
@@ -276,13 +306,7 @@ fn closest_deep(bvh: &Bvh8, ray: &Ray, tmax: f32, isa: Isa) -> Found {
 #[inline(never)]
 fn any_deep(bvh: &Bvh8, ray: &Ray, isa: Isa) -> bool {
     let stack = &mut heap_stack(bvh.depth);
-    #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx2 {
-        // SAFETY: as in `closest_deep`.
-        return unsafe { traverse::any_avx2(bvh, ray, stack) };
-    }
-    let _ = isa;
-    traverse::any_portable(bvh, ray, stack)
+    dispatch!(isa, true, any_avx512, any_avx2, any_portable, (bvh, ray, stack))
 }
 
 /// Shape and triangle of builder index `id`.

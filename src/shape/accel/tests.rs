@@ -43,13 +43,15 @@ fn brute_force(shapes: &[Shape], ray: &Ray) -> Option<(u32, f32)> {
     best
 }
 
-/// Both node tests give the same masks and entry distances on every node.
+/// The ISAs this CPU runs, lowest first.
+fn isas() -> Vec<Isa> {
+    [Isa::Portable, Isa::Avx2, Isa::Avx512].into_iter().filter(|&i| i <= Isa::detect()).collect()
+}
+
+/// Every node test the CPU runs gives the portable one's masks and entry distances on every node.
 #[cfg(target_arch = "x86_64")]
 #[test]
-fn avx_node_test_equals_portable() {
-    if Isa::detect() != Isa::Avx2 {
-        return;
-    }
+fn simd_node_tests_equal_portable() {
     let shapes = soup(11, 3000, 10.0);
     let accel = Accel::build(&shapes);
     let bvh = accel.bvh.as_ref().unwrap();
@@ -59,18 +61,75 @@ fn avx_node_test_equals_portable() {
         let r = random_ray(&mut s, i, 10.0);
         let nr = traverse::NodeRay::new(r.o, r.d);
         for node in &bvh.nodes {
-            let (mut a, mut b) = ([0.0; 8], [0.0; 8]);
+            let mut a = [0.0; 8];
             let ma = traverse::node_test_portable(node, &nr, r.tmax, &mut a);
-            // SAFETY: AVX2 support checked above.
-            let mb = unsafe { traverse::node_test_avx(node, &nr, r.tmax, &mut b) };
-            assert_eq!(ma, mb);
-            for k in 0..8 {
-                if ma & (1 << k) != 0 {
-                    assert_eq!(a[k].to_bits(), b[k].to_bits());
+            let check = |mb: u32, b: [f32; 8]| {
+                assert_eq!(ma, mb);
+                for k in 0..8 {
+                    if ma & (1 << k) != 0 {
+                        assert_eq!(a[k].to_bits(), b[k].to_bits());
+                    }
                 }
+            };
+            if Isa::detect() >= Isa::Avx2 {
+                let mut b = [0.0; 8];
+                // SAFETY: AVX2 support checked.
+                check(unsafe { traverse::node_test_avx(node, &nr, r.tmax, &mut b) }, b);
+            }
+            if Isa::detect() >= Isa::Avx512 {
+                let mut b = [0.0; 8];
+                // SAFETY: AVX-512 support checked.
+                check(unsafe { traverse::node_test_avx512(node, &nr, r.tmax, &mut b) }, b);
             }
         }
     }
+}
+
+/// The traversals of every ISA the CPU runs find the same hit bit for bit (lane, t, b1, b2) and
+/// the same occlusion, on rays through dense and sparse soups (many nodes with three or more hit
+/// children, so every ordering path runs), rays aimed at vertices and edges, and a deep tree's
+/// heap stack path (the closed sphere in `tests/accel.rs` covers watertightness).
+#[test]
+fn traversals_of_every_isa_agree() {
+    for (seed, count, spread) in [(31, 4000, 6.0), (32, 1500, 30.0), (33, 20, 2.0)] {
+        let shapes = soup(seed, count, spread);
+        let accels: Vec<Accel> = isas().into_iter().map(|isa| Accel::build_with(&shapes, isa)).collect();
+        let Geometry::Mesh(m) = &shapes[0].geometry else { unreachable!() };
+        let mut s = Sampler::new(seed + 7, 0);
+        let mut hits = 0;
+        for i in 0..6000 {
+            let mut r = random_ray(&mut s, i, spread);
+            if i % 3 == 0 {
+                let v = m.vertices(((s.next_1d() * count as f32) as u32).min(count - 1));
+                let target = if i % 2 == 0 { v[(i / 6) % 3] } else { v[0] + (v[1] - v[0]) * s.next_1d() };
+                r.d = (target - r.o).normalize();
+            }
+            let key = |h: Option<Hit>| h.map(|h| (h.shape, h.prim, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
+            let want = key(accels[0].intersect(&shapes, &r));
+            let occluded = accels[0].occluded(&shapes, &r);
+            hits += want.is_some() as u32;
+            for a in &accels[1..] {
+                assert_eq!(key(a.intersect(&shapes, &r)), want, "{:?} ray {r:?}", a.isa);
+                assert_eq!(a.occluded(&shapes, &r), occluded, "{:?} ray {r:?}", a.isa);
+                let bvh = a.bvh.as_ref().unwrap();
+                // The heap-stack traversals (trees too deep for the fixed stack) are the same code.
+                let tmax = r.tmax;
+                let (f, g) = (closest_deep(bvh, &r, tmax, a.isa), a.closest(bvh, &r, tmax));
+                assert_eq!((f.lane, f.t.to_bits(), f.b1.to_bits()), (g.lane, g.t.to_bits(), g.b1.to_bits()));
+                assert_eq!(any_deep(bvh, &r, a.isa), occluded);
+            }
+        }
+        assert!(hits > 500, "only {hits} hits");
+    }
+}
+
+/// `Isa::selected` never exceeds what the CPU runs, and `build_with` caps a request at it.
+#[test]
+fn isa_is_capped_at_the_cpu() {
+    assert!(Isa::selected() <= Isa::detect());
+    let shapes = soup(1, 10, 1.0);
+    assert_eq!(Accel::build_with(&shapes, Isa::Avx512).isa, Isa::detect());
+    assert_eq!(Accel::build_with(&shapes, Isa::Portable).isa, Isa::Portable);
 }
 
 /// Closest hit and occlusion through the BVH equal brute force over all triangles (same
@@ -79,7 +138,7 @@ fn avx_node_test_equals_portable() {
 fn traversal_equals_brute_force() {
     for (seed, count, spread) in [(1, 2000, 10.0), (2, 500, 40.0), (3, 3, 1.0), (4, 40, 3.0)] {
         let shapes = soup(seed, count, spread);
-        for isa in [Isa::Portable, Isa::detect()] {
+        for isa in isas() {
             let accel = Accel::build_with(&shapes, isa);
             let mut s = Sampler::new(seed + 100, 0);
             let mut hits = 0;
@@ -123,7 +182,7 @@ fn traversal_equals_brute_force() {
 #[test]
 fn non_finite_rays_do_not_panic() {
     let shapes = soup(5, 500, 10.0);
-    for isa in [Isa::Portable, Isa::detect()] {
+    for isa in isas() {
         let accel = Accel::build_with(&shapes, isa);
         let bad = [
             Ray { o: Vec3::splat(5.0), d: Vec3::splat(f32::NAN), tmax: f32::INFINITY },

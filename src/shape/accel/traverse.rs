@@ -282,7 +282,7 @@ macro_rules! at_mut {
 /// (entry distance with the slot in the low three bits) into descending order; pushes all but the
 /// last (the nearest) onto the stack, farthest first, advances `sp` and yields the nearest child.
 macro_rules! order_push_portable {
-    ($node:expr, $mask:expr, $t_near:expr, $stack:expr, $sp:ident, $key:ident) => {{
+    ($node:expr, $mask:expr, $tn:expr, $t_near:expr, $stack:expr, $sp:ident, $key:ident) => {{
         let (node, mut mask, stack): (&Node8, u32, &mut Stack) = ($node, $mask, $stack);
         let mut keys = [0u32; 8];
         let mut n = 0;
@@ -314,7 +314,7 @@ macro_rules! order_push_portable {
 /// The same order as the insertion sort (the keys are distinct), so the same traversal.
 #[cfg(target_arch = "x86_64")]
 macro_rules! order_push_avx2 {
-    ($node:expr, $mask:expr, $t_near:expr, $stack:expr, $sp:ident, $key:ident) => {{
+    ($node:expr, $mask:expr, $tn:expr, $t_near:expr, $stack:expr, $sp:ident, $key:ident) => {{
         use std::arch::x86_64::*;
         let (node, mask, t_near, stack): (&Node8, u32, &[f32; 8], &mut Stack) = ($node, $mask, $t_near, $stack);
         let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
@@ -356,11 +356,62 @@ macro_rules! order_push_avx2 {
     }};
 }
 
+/// BVHs of more bytes than this are traversed with [`prefetch_child`] of each stack entry: a
+/// tree that fits in the L2 cache gains nothing by it and pays its instructions.
+pub const PREFETCH_BYTES: usize = 1 << 20;
+
+/// Start loading child `c` (a node or a leaf packet) into the cache: a child pushed onto the stack
+/// is visited after the nearer one's subtree, by when the load has arrived. A hint only: it
+/// changes no result, and a prefetch never faults.
+#[inline(always)]
+fn prefetch_child<const PF: bool>(bvh: &Bvh8, c: u32) {
+    #[cfg(target_arch = "x86_64")]
+    if PF {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let (p, lines) = if c & LEAF == 0 {
+            (bvh.nodes.as_ptr().wrapping_add(c as usize).cast::<i8>(), 4)
+        } else {
+            (bvh.packets.as_ptr().wrapping_add((c & !LEAF) as usize).cast::<i8>(), 3)
+        };
+        for l in 0..lines {
+            // SAFETY: `_mm_prefetch` is SSE (every x86-64 CPU) and never faults.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * l)) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (PF, bvh, c);
+}
+
+/// [`prefetch_child`] of the stack's top entry (the next to be popped), if any: every entry is
+/// prefetched once it is on top, a whole subtree's traversal before it is visited.
+macro_rules! prefetch_top {
+    ($bvh:expr, $stack:expr, $sp:expr, $chk:ident) => {
+        if PF && $sp > 0 {
+            // SAFETY: entries below `sp` were written.
+            #[allow(unused_unsafe)]
+            let e = unsafe { at!($chk, $stack, $sp - 1).assume_init() };
+            prefetch_child::<PF>($bvh, e.child);
+        }
+    };
+}
+
+/// A leaf test `$f` (a method of `WatertightRay`); the `_avx512` ones are `unsafe` (they need the
+/// CPU features of the traversal that calls them).
+macro_rules! leaf {
+    ($f:ident, $wt:expr, $p:expr, $tmax:expr) => {{
+        #[allow(unused_unsafe)]
+        // SAFETY: an `_avx512` test runs only in `closest_avx512` / `any_avx512`, whose callers
+        // guarantee the features.
+        let r = unsafe { $wt.$f($p, $tmax) };
+        r
+    }};
+}
+
 /// Closest-hit traversal with node test `$node_test`: the nearest triangle in (0, tmax) as a
 /// [`Found`]. A macro, so that each instance is compiled with the target features of the function
 /// it expands in and the node test inlines.
 macro_rules! closest_body {
-    ($bvh:expr, $ray:expr, $tmax:expr, $stack:expr, $node_test:ident, $store:ident, $order:ident, $chk:ident) => {{
+    ($bvh:expr, $ray:expr, $tmax:expr, $stack:expr, $node_test:ident, $store:ident, $order:ident, $nearest:ident, $chk:ident) => {{
         let (bvh, ray, mut tmax, stack): (&Bvh8, &Ray, f32, &mut Stack) = ($bvh, $ray, $tmax, $stack);
         let tr = TraceRay::new(ray.o, ray.d);
         let (nr, wt) = (&tr.node, &tr.wt);
@@ -393,18 +444,21 @@ macro_rules! closest_body {
                     // Exactly two (the most common case): one comparison.
                     let (a, b) = (key(first), key(rest.trailing_zeros()));
                     let (near, far) = if a < b { (a, b) } else { (b, a) };
+                    let far_child = node.child[(far & 7) as usize];
+                    prefetch_child::<PF>(bvh, far_child);
                     *at_mut!($chk, stack, sp) =
-                        MaybeUninit::new(Entry { child: node.child[(far & 7) as usize], t: f32::from_bits(far & !7) });
+                        MaybeUninit::new(Entry { child: far_child, t: f32::from_bits(far & !7) });
                     sp += 1;
                     cur = node.child[(near & 7) as usize];
                     continue;
                 }
                 // Three or more: all but the nearest pushed, farthest first.
-                cur = $order!(node, mask, &t_near, &mut *stack, sp, key);
+                cur = $order!(node, mask, tn, &t_near, &mut *stack, sp, key);
+                prefetch_top!(bvh, stack, sp, $chk);
             }
             if cur < DONE {
                 let packet = (cur & !LEAF) as usize;
-                if let Some((lane, t, b1, b2)) = wt.nearest4(at!($chk, bvh.packets, packet), tmax) {
+                if let Some((lane, t, b1, b2)) = leaf!($nearest, wt, at!($chk, bvh.packets, packet), tmax) {
                     (hit_lane, tmax, hit_b1, hit_b2) = ((4 * packet + lane) as u32, t, b1, b2);
                     prefetch(bvh.lanes.as_ptr().wrapping_add(packet).cast::<LaneShade>().wrapping_add(lane));
                 }
@@ -423,13 +477,14 @@ macro_rules! closest_body {
                     break;
                 }
             }
+            prefetch_top!(bvh, stack, sp, $chk);
         }
     }};
 }
 
 /// Any-hit traversal with node test `$node_test`: true when a triangle is hit in (0, tmax).
 macro_rules! any_body {
-    ($bvh:expr, $ray:expr, $stack:expr, $node_test:ident, $chk:ident) => {{
+    ($bvh:expr, $ray:expr, $stack:expr, $node_test:ident, $push_rest:ident, $any:ident, $chk:ident) => {{
         let (bvh, ray, stack): (&Bvh8, &Ray, &mut Stack) = ($bvh, $ray, $stack);
         let tmax = ray.tmax;
         let tr = TraceRay::new(ray.o, ray.d);
@@ -439,22 +494,17 @@ macro_rules! any_body {
         loop {
             if cur & LEAF == 0 {
                 let node = at!($chk, bvh.nodes, cur as usize);
-                let (mut mask, _) = $node_test!(node, nr, tmax);
+                let (mask, _) = $node_test!(node, nr, tmax);
                 if mask != 0 {
                     // Descend into the hit child of the highest slot; push the others (lowest
                     // first, so they are visited from the highest down).
                     let last = 31 - mask.leading_zeros();
-                    mask &= !(1 << last);
-                    while mask != 0 {
-                        let slot = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        *at_mut!($chk, stack, sp) = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
-                        sp += 1;
-                    }
+                    $push_rest!(bvh, node, mask & !(1 << last), &mut *stack, sp, $chk);
+                    prefetch_top!(bvh, stack, sp, $chk);
                     cur = node.child[last as usize];
                     continue;
                 }
-            } else if wt.any4(at!($chk, bvh.packets, (cur & !LEAF) as usize), tmax) {
+            } else if leaf!($any, wt, at!($chk, bvh.packets, (cur & !LEAF) as usize), tmax) {
                 break true;
             }
             if sp == 0 {
@@ -464,13 +514,27 @@ macro_rules! any_body {
             // SAFETY: entries below `sp` were written.
             let e = *at!($chk, stack, sp);
             cur = unsafe { e.assume_init() }.child;
+            prefetch_top!(bvh, stack, sp, $chk);
+        }
+    }};
+}
+
+/// The any-hit traversal's push of the children in `mask`, lowest slot first, one at a time.
+macro_rules! push_rest_scalar {
+    ($bvh:expr, $node:expr, $mask:expr, $stack:expr, $sp:ident, $chk:ident) => {{
+        let (node, mut mask, stack): (&Node8, u32, &mut Stack) = ($node, $mask, $stack);
+        while mask != 0 {
+            let slot = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            *at_mut!($chk, stack, $sp) = MaybeUninit::new(Entry { child: node.child[slot], t: 0.0 });
+            $sp += 1;
         }
     }};
 }
 
 /// Closest hit, portable node test.
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t > tmax)`: see the pop in `closest_body`
-pub fn closest_portable(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
+pub fn closest_portable<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
     closest_body!(
         bvh,
         ray,
@@ -479,13 +543,14 @@ pub fn closest_portable(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> 
         node_test_portable_body,
         store_near_portable_body,
         order_push_portable,
+        nearest4,
         checked
     )
 }
 
 /// Any hit, portable node test.
-pub fn any_portable(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
-    any_body!(bvh, ray, stack, node_test_portable_body, checked)
+pub fn any_portable<const PF: bool>(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+    any_body!(bvh, ray, stack, node_test_portable_body, push_rest_scalar, any4, checked)
 }
 
 /// Closest hit, AVX node test.
@@ -497,8 +562,8 @@ pub fn any_portable(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t > tmax)`: see the pop in `closest_body`
-pub unsafe fn closest_avx2(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
-    closest_body!(bvh, ray, tmax, stack, node_test_avx_body, store_near_avx, order_push_avx2, unchecked)
+pub unsafe fn closest_avx2<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
+    closest_body!(bvh, ray, tmax, stack, node_test_avx_body, store_near_avx, order_push_avx2, nearest4, unchecked)
 }
 
 /// Any hit, AVX node test.
@@ -507,6 +572,147 @@ pub unsafe fn closest_avx2(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) 
 /// As for `closest_avx2`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
-pub unsafe fn any_avx2(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
-    any_body!(bvh, ray, stack, node_test_avx_body, unchecked)
+pub unsafe fn any_avx2<const PF: bool>(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+    any_body!(bvh, ray, stack, node_test_avx_body, push_rest_scalar, any4, unchecked)
+}
+
+/// The slab test of [`node_test_avx_body`] (the same float operations on the same registers) with
+/// the comparison straight into a mask register (AVX-512VL), which the traversal branches on.
+#[cfg(target_arch = "x86_64")]
+macro_rules! node_test_avx512_body {
+    ($node:expr, $r:expr, $tmax:expr) => {{
+        use std::arch::x86_64::*;
+        let (node, r, tmax): (&Node8, &NodeRay, f32) = ($node, $r, $tmax);
+        macro_rules! slab {
+            ($a:expr) => {{
+                let neg_o = _mm256_set1_ps(r.neg_o[$a]);
+                let inv = _mm256_set1_ps(r.inv_d[$a]);
+                // SAFETY: `r.near`/`r.far` are row offsets as `NodeRay::with_inverse` sets them.
+                let near = _mm256_loadu_ps(unsafe { node.row(r.near[$a]) });
+                let far = _mm256_loadu_ps(unsafe { node.row(r.far[$a]) });
+                (_mm256_mul_ps(_mm256_add_ps(near, neg_o), inv), _mm256_mul_ps(_mm256_add_ps(far, neg_o), inv))
+            }};
+        }
+        let (nx, fx) = slab!(0);
+        let (ny, fy) = slab!(1);
+        let (nz, fz) = slab!(2);
+        let tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_setzero_ps()));
+        let tf = _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(fx, fy), fz), _mm256_set1_ps(FAR_SCALE));
+        let tf = _mm256_min_ps(tf, _mm256_set1_ps(tmax));
+        (_mm256_cmp_ps_mask::<_CMP_LE_OQ>(tn, tf) as u32, tn)
+    }};
+}
+
+/// The AVX-512 slab test as a function (for tests).
+///
+/// # Safety
+/// The CPU must support AVX-512F and AVX-512VL, and `r` must come from [`NodeRay::new`] or
+/// [`NodeRay::with_inverse`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl")]
+pub unsafe fn node_test_avx512(node: &Node8, r: &NodeRay, tmax: f32, t_near: &mut [f32; 8]) -> u32 {
+    let (mask, tn) = node_test_avx512_body!(node, r, tmax);
+    store_near_avx!(tn, t_near);
+    mask
+}
+
+/// [`order_push_avx2`] with AVX-512VL: the keys made in one ternary-logic instruction, zero in the
+/// missed lanes (a zero-masked write), each compare-exchange layer a min and a max merged under
+/// a lane mask (no blend), and the eight (child, t) entries interleaved by one two-table permute
+/// into one 64-byte store. The same sorting network on the same keys, so the same order.
+#[cfg(target_arch = "x86_64")]
+macro_rules! order_push_avx512 {
+    ($node:expr, $mask:expr, $tn:expr, $t_near:expr, $stack:expr, $sp:ident, $key:ident) => {{
+        use std::arch::x86_64::*;
+        let (node, mask, tn, stack): (&Node8, u32, __m256, &mut Stack) = ($node, $mask, $tn, $stack);
+        let slot = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        let not7 = _mm256_set1_epi32(!7);
+        // (t & !7) | slot (truth table 0xEA: A & B | C), 0 where missed.
+        let mut k = _mm256_maskz_ternarylogic_epi32::<0xEA>(mask as __mmask8, _mm256_castps_si256(tn), not7, slot);
+        // Compare-exchange with the partner lane `i ^ j`; mask bit i set: lane i keeps the max.
+        macro_rules! layer {
+            ($partner:expr, $keep_max:literal) => {{
+                let p = $partner;
+                k = _mm256_mask_max_epu32(_mm256_min_epu32(k, p), $keep_max, k, p);
+            }};
+        }
+        layer!(_mm256_shuffle_epi32::<0xB1>(k), 0x99); // j = 1 in blocks of 2
+        layer!(_mm256_shuffle_epi32::<0x4E>(k), 0xC3); // j = 2 in blocks of 4
+        layer!(_mm256_shuffle_epi32::<0xB1>(k), 0xA5); // j = 1 in blocks of 4
+        layer!(_mm256_permute4x64_epi64::<0x4E>(k), 0x0F); // j = 4, whole register descending
+        layer!(_mm256_shuffle_epi32::<0x4E>(k), 0x33); // j = 2
+        layer!(_mm256_shuffle_epi32::<0xB1>(k), 0x55); // j = 1
+        // The child of each key by its slot bits (the permute reads only the low three bits).
+        let children = _mm256_loadu_si256(node.child.as_ptr().cast());
+        let child = _mm256_permutexvar_epi32(k, children);
+        let tk = _mm256_and_si256(k, not7);
+        // (child, t) pairs: lane 2i from `child` lane i, lane 2i + 1 from `tk` lane i (16 + i).
+        let pairs = _mm512_permutex2var_epi32(
+            _mm512_castsi256_si512(child),
+            _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23),
+            _mm512_castsi256_si512(tk),
+        );
+        let n = mask.count_ones() as usize;
+        debug_assert!($sp + 8 <= stack.len());
+        // SAFETY: `stack_size` leaves room for eight entries from any `sp` the traversal reaches
+        // (at most 7 per level above), and `Entry` is `repr(C)` (child, t).
+        unsafe { _mm512_storeu_si512(stack.as_mut_ptr().add($sp).cast(), pairs) };
+        $sp += n - 1;
+        // SAFETY: written just above.
+        unsafe { stack.get_unchecked($sp).assume_init().child }
+    }};
+}
+
+/// [`push_rest_scalar`] with AVX-512: the children zero-extended to (child, 0.0) pairs and the
+/// pushed ones compressed to the front of the register (in slot order) for one 64-byte store;
+/// no loop, so no branch on how many are pushed.
+#[cfg(target_arch = "x86_64")]
+macro_rules! push_rest_avx512 {
+    ($bvh:expr, $node:expr, $mask:expr, $stack:expr, $sp:ident, $chk:ident) => {{
+        use std::arch::x86_64::*;
+        let (node, mask, stack): (&Node8, u32, &mut Stack) = ($node, $mask, $stack);
+        let pairs = _mm512_cvtepu32_epi64(_mm256_loadu_si256(node.child.as_ptr().cast()));
+        debug_assert!($sp + 8 <= stack.len());
+        // SAFETY: as in `order_push_avx512` (at most 7 entries per level; `Entry` is (child, t),
+        // and 0.0 is all zero bits).
+        unsafe {
+            _mm512_storeu_si512(
+                stack.as_mut_ptr().add($sp).cast(),
+                _mm512_maskz_compress_epi64(mask as __mmask8, pairs),
+            )
+        };
+        $sp += mask.count_ones() as usize;
+    }};
+}
+
+/// Closest hit, AVX-512 node test and ordering.
+///
+/// # Safety
+/// The CPU must support AVX-512F/VL/BW/DQ, AVX2, BMI1, LZCNT and POPCNT (`Isa::detect`); `bvh` and
+/// `stack` as for `closest_avx2`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl,avx512bw,avx512dq,bmi1,lzcnt,popcnt")]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t > tmax)`: see the pop in `closest_body`
+pub unsafe fn closest_avx512<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
+    closest_body!(
+        bvh,
+        ray,
+        tmax,
+        stack,
+        node_test_avx512_body,
+        store_near_avx,
+        order_push_avx512,
+        nearest4_avx512,
+        unchecked
+    )
+}
+
+/// Any hit, AVX-512 node test and push.
+///
+/// # Safety
+/// As for `closest_avx512`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl,avx512bw,avx512dq,bmi1,lzcnt,popcnt")]
+pub unsafe fn any_avx512<const PF: bool>(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+    any_body!(bvh, ray, stack, node_test_avx512_body, push_rest_avx512, any4_avx512, unchecked)
 }

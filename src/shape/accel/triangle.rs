@@ -118,6 +118,61 @@ fn edges_f64(ray: WatertightRay, p: &TriPacket4, lanes: u32, uvw: [Vec4; 3]) -> 
     [Vec4::select(m, u, uvw[0]), Vec4::select(m, v, uvw[1]), Vec4::select(m, w, uvw[2])]
 }
 
+/// The nearest of the hit lanes `mask` (ties to the lowest): (lane, t, b1, b2).
+#[inline(always)]
+fn nearest_lane(mut mask: u32, t: Vec4, b1: Vec4, b2: Vec4) -> Option<(usize, f32, f32, f32)> {
+    if mask == 0 {
+        return None;
+    }
+    let t = t.to_array();
+    // `& 3`: the lanes of a 4-bit mask (free where the compiler knows `mask < 16`; elsewhere it
+    // replaces a bounds check).
+    let mut best = mask.trailing_zeros() as usize & 3;
+    mask &= mask - 1;
+    while mask != 0 {
+        let l = mask.trailing_zeros() as usize & 3;
+        mask &= mask - 1;
+        if t[l] < t[best] {
+            best = l;
+        }
+    }
+    Some((best, t[best], b1.to_array()[best], b2.to_array()[best]))
+}
+
+/// The packet test after the edge functions `uvw` (and the sheared z coordinates `z` of the three
+/// vertices): the lanes hit in (0, tmax) and their (t, b1, b2).
+#[inline(always)]
+fn finish4([u, v, w]: [Vec4; 3], [az, bz, cz]: [Vec4; 3], tmax: f32) -> (u32, Vec4, Vec4, Vec4) {
+    let zero = Vec4::ZERO;
+    let neg = (u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero)).bitmask();
+    let pos = (u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero)).bitmask();
+    let det = u + v + w;
+    let t_scaled = u * az + v * bz + w * cz;
+    let inv_det = Vec4::ONE / det;
+    let t = t_scaled * inv_det;
+    let mask =
+        !(neg & pos) & det.cmpne(zero).bitmask() & t.cmpgt(zero).bitmask() & t.cmplt(Vec4::splat(tmax)).bitmask();
+    (mask & 0xF, t, v * inv_det, w * inv_det)
+}
+
+/// The rest of the packet test when an edge function of the lanes `lanes` is exactly 0: those
+/// recomputed in `f64` ([`edges_f64`]), the vertices sheared again (the same operations, so the
+/// same bits) for their z, and [`finish4`]. Rare, so out of line (for the AVX-512 test).
+#[cold]
+#[inline(never)]
+#[cfg(target_arch = "x86_64")]
+fn intersect4_exact_zero(
+    ray: WatertightRay,
+    p: &TriPacket4,
+    lanes: u32,
+    uvw: [Vec4; 3],
+    tmax: f32,
+) -> (u32, Vec4, Vec4, Vec4) {
+    let uvw = edges_f64(ray, p, lanes, uvw);
+    let z = [0, 1, 2].map(|j| sheared(&ray, p, j).2);
+    finish4(uvw, z, tmax)
+}
+
 /// Sheared vertex coordinates (x, y, z) of one vertex in the four lanes.
 #[inline(always)]
 fn sheared(w: &WatertightRay, p: &TriPacket4, j: usize) -> (Vec4, Vec4, Vec4) {
@@ -204,41 +259,87 @@ impl WatertightRay {
             // at once, kept only where needed; the same products and roundings as scalar code).
             [u, v, w] = edges_f64(*self, p, exact_zero, [u, v, w]);
         }
-        let neg = (u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero)).bitmask();
-        let pos = (u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero)).bitmask();
-        let det = u + v + w;
-        let t_scaled = u * az + v * bz + w * cz;
-        let inv_det = Vec4::ONE / det;
-        let t = t_scaled * inv_det;
-        let mask =
-            !(neg & pos) & det.cmpne(zero).bitmask() & t.cmpgt(zero).bitmask() & t.cmplt(Vec4::splat(tmax)).bitmask();
-        (mask & 0xF, t, v * inv_det, w * inv_det)
+        finish4([u, v, w], [az, bz, cz], tmax)
     }
 
     /// The nearest hit in (0, tmax): (lane, t, b1, b2). Ties go to the lowest lane.
     #[inline(always)]
     pub fn nearest4(&self, p: &TriPacket4, tmax: f32) -> Option<(usize, f32, f32, f32)> {
-        let (mut mask, t, b1, b2) = self.intersect4(p, tmax);
-        if mask == 0 {
-            return None;
-        }
-        let t = t.to_array();
-        let mut best = mask.trailing_zeros() as usize;
-        mask &= mask - 1;
-        while mask != 0 {
-            let l = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            if t[l] < t[best] {
-                best = l;
-            }
-        }
-        Some((best, t[best], b1.to_array()[best], b2.to_array()[best]))
+        let (mask, t, b1, b2) = self.intersect4(p, tmax);
+        nearest_lane(mask, t, b1, b2)
     }
 
     /// True when any of the four triangles is hit in (0, tmax).
     #[inline(always)]
     pub fn any4(&self, p: &TriPacket4, tmax: f32) -> bool {
         self.intersect4(p, tmax).0 != 0
+    }
+}
+
+/// The AVX-512 forms of the packet test: the same float operations as [`WatertightRay::intersect4`]
+/// (so the same t, b1, b2 bits), with the lane decisions taken in mask registers (AVX-512VL).
+#[cfg(target_arch = "x86_64")]
+impl WatertightRay {
+    /// [`WatertightRay::intersect4`] with masks: the three exact-zero tests OR-ed as masks; the
+    /// sign test as "min(u, v, w) < 0 and max(u, v, w) > 0" (for non-NaN values the same as "some
+    /// edge function negative and some positive"; a NaN edge function makes `det` and so `t` NaN,
+    /// which `t > 0` rejects either way), the one comparison masked by the other; and the
+    /// `det ≠ 0`, `t > 0`, `t < tmax` tests chained as masked comparisons.
+    ///
+    /// Not itself a `target_feature` function (those cannot be `inline(always)`): it inlines into
+    /// the AVX-512 traversal, and the intrinsics with it.
+    ///
+    /// # Safety
+    /// The CPU must support AVX-512F and AVX-512VL.
+    #[inline(always)]
+    pub unsafe fn intersect4_avx512(&self, p: &TriPacket4, tmax: f32) -> (u32, Vec4, Vec4, Vec4) {
+        use std::arch::x86_64::*;
+        // SAFETY (every intrinsic below): the caller's contract.
+        let (ax, ay, az) = sheared(self, p, 0);
+        let (bx, by, bz) = sheared(self, p, 1);
+        let (cx, cy, cz) = sheared(self, p, 2);
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let zero = _mm_setzero_ps();
+        let is_zero = |x: Vec4| _mm_cmp_ps_mask::<_CMP_EQ_OQ>(x.into(), zero);
+        let exact_zero = is_zero(u) | is_zero(v) | is_zero(w);
+        if exact_zero != 0 {
+            // The whole rest of the test out of line: nothing but the traversal's own state is
+            // live across the call, so the common path spills nothing for it.
+            return intersect4_exact_zero(*self, p, exact_zero as u32, [u, v, w], tmax);
+        }
+        let (mn, mx) = (u.min(v).min(w), u.max(v).max(w));
+        let mixed = _mm_mask_cmp_ps_mask::<_CMP_GT_OQ>(_mm_cmp_ps_mask::<_CMP_LT_OQ>(mn.into(), zero), mx.into(), zero);
+        let det = u + v + w;
+        let t_scaled = u * az + v * bz + w * cz;
+        let inv_det = Vec4::ONE / det;
+        let t = t_scaled * inv_det;
+        let ok = _mm_cmp_ps_mask::<_CMP_NEQ_UQ>(det.into(), zero);
+        let ok = _mm_mask_cmp_ps_mask::<_CMP_GT_OQ>(ok, t.into(), zero);
+        let ok = _mm_mask_cmp_ps_mask::<_CMP_LT_OQ>(ok, t.into(), _mm_set1_ps(tmax));
+        ((ok & !mixed & 0xF) as u32, t, v * inv_det, w * inv_det)
+    }
+
+    /// [`WatertightRay::nearest4`] on [`WatertightRay::intersect4_avx512`].
+    ///
+    /// # Safety
+    /// As for `intersect4_avx512`.
+    #[inline(always)]
+    pub unsafe fn nearest4_avx512(&self, p: &TriPacket4, tmax: f32) -> Option<(usize, f32, f32, f32)> {
+        // SAFETY: the caller's contract.
+        let (mask, t, b1, b2) = unsafe { self.intersect4_avx512(p, tmax) };
+        nearest_lane(mask, t, b1, b2)
+    }
+
+    /// [`WatertightRay::any4`] on [`WatertightRay::intersect4_avx512`].
+    ///
+    /// # Safety
+    /// As for `intersect4_avx512`.
+    #[inline(always)]
+    pub unsafe fn any4_avx512(&self, p: &TriPacket4, tmax: f32) -> bool {
+        // SAFETY: the caller's contract.
+        unsafe { self.intersect4_avx512(p, tmax) }.0 != 0
     }
 }
 
@@ -280,9 +381,12 @@ mod tests {
     }
 
     /// Every lane of the 4-wide test gives the scalar test's bits, on rays aimed at vertices,
-    /// edges, interiors and random points, some axis-aligned; unused lanes never hit.
+    /// edges, interiors and random points, some axis-aligned; unused lanes never hit. The AVX-512
+    /// test (where the CPU has it) gives the same lanes and bits.
     #[test]
     fn packet_test_equals_scalar_reference() {
+        #[cfg(target_arch = "x86_64")]
+        let avx512 = std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl");
         let mut s = Sampler::new(7, 0);
         let r3 = |s: &mut Sampler| Vec3::new(s.next_1d(), s.next_1d(), s.next_1d()) * 4.0 - 2.0;
         let (mut hits, mut n) = (0, 0);
@@ -307,7 +411,20 @@ mod tests {
             for (l, t) in tris.iter().enumerate().take(lanes) {
                 p.set(l, *t);
             }
-            let (mask, t, b1, b2) = WatertightRay::new(ray.o, ray.d).intersect4(&p, ray.tmax);
+            let wt = WatertightRay::new(ray.o, ray.d);
+            let (mask, t, b1, b2) = wt.intersect4(&p, ray.tmax);
+            #[cfg(target_arch = "x86_64")]
+            if avx512 {
+                // SAFETY: AVX-512F/VL support checked.
+                let (m, t2, b1_2, b2_2) = unsafe { wt.intersect4_avx512(&p, ray.tmax) };
+                assert_eq!(m, mask, "ray {ray:?}");
+                for l in 0..4 {
+                    if mask & (1 << l) != 0 {
+                        let bits = |v: Vec4| v.to_array()[l].to_bits();
+                        assert_eq!((bits(t2), bits(b1_2), bits(b2_2)), (bits(t), bits(b1), bits(b2)));
+                    }
+                }
+            }
             for (l, tri) in tris.iter().enumerate() {
                 let want = if l < lanes { woop_scalar(&ray, *tri, ray.tmax) } else { None };
                 let got = (mask & (1 << l) != 0).then(|| (t.to_array()[l], b1.to_array()[l], b2.to_array()[l]));
