@@ -139,10 +139,10 @@ fn store_near_portable(tn: [Vec4; 2], t_near: &mut [f32; 8]) {
     tn[1].write_to_slice(&mut t_near[4..]);
 }
 
-/// The same slab test in one AVX register per plane (a macro so that it inlines into the AVX2
-/// traversal; see `node_test_avx` for a callable version).
+/// The slab test's entry and exit distances of the eight children in AVX registers (`tn`, `tf`),
+/// shared by the AVX2 and AVX-512 node tests, which differ only in how they read the comparison.
 #[cfg(target_arch = "x86_64")]
-macro_rules! node_test_avx_body {
+macro_rules! slab_avx {
     ($node:expr, $r:expr, $tmax:expr) => {{
         use std::arch::x86_64::*;
         let (node, r, tmax): (&Node8, &NodeRay, f32) = ($node, $r, $tmax);
@@ -162,6 +162,17 @@ macro_rules! node_test_avx_body {
         let tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_setzero_ps()));
         let tf = _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(fx, fy), fz), _mm256_set1_ps(FAR_SCALE));
         let tf = _mm256_min_ps(tf, _mm256_set1_ps(tmax));
+        (tn, tf)
+    }};
+}
+
+/// The same slab test in one AVX register per plane (a macro so that it inlines into the AVX2
+/// traversal; see `node_test_avx` for a callable version).
+#[cfg(target_arch = "x86_64")]
+macro_rules! node_test_avx_body {
+    ($node:expr, $r:expr, $tmax:expr) => {{
+        use std::arch::x86_64::*;
+        let (tn, tf) = slab_avx!($node, $r, $tmax);
         (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as u32, tn)
     }};
 }
@@ -582,23 +593,7 @@ pub unsafe fn any_avx2<const PF: bool>(bvh: &Bvh8, ray: &Ray, stack: &mut Stack)
 macro_rules! node_test_avx512_body {
     ($node:expr, $r:expr, $tmax:expr) => {{
         use std::arch::x86_64::*;
-        let (node, r, tmax): (&Node8, &NodeRay, f32) = ($node, $r, $tmax);
-        macro_rules! slab {
-            ($a:expr) => {{
-                let neg_o = _mm256_set1_ps(r.neg_o[$a]);
-                let inv = _mm256_set1_ps(r.inv_d[$a]);
-                // SAFETY: `r.near`/`r.far` are row offsets as `NodeRay::with_inverse` sets them.
-                let near = _mm256_loadu_ps(unsafe { node.row(r.near[$a]) });
-                let far = _mm256_loadu_ps(unsafe { node.row(r.far[$a]) });
-                (_mm256_mul_ps(_mm256_add_ps(near, neg_o), inv), _mm256_mul_ps(_mm256_add_ps(far, neg_o), inv))
-            }};
-        }
-        let (nx, fx) = slab!(0);
-        let (ny, fy) = slab!(1);
-        let (nz, fz) = slab!(2);
-        let tn = _mm256_max_ps(_mm256_max_ps(nx, ny), _mm256_max_ps(nz, _mm256_setzero_ps()));
-        let tf = _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(fx, fy), fz), _mm256_set1_ps(FAR_SCALE));
-        let tf = _mm256_min_ps(tf, _mm256_set1_ps(tmax));
+        let (tn, tf) = slab_avx!($node, $r, $tmax);
         (_mm256_cmp_ps_mask::<_CMP_LE_OQ>(tn, tf) as u32, tn)
     }};
 }
