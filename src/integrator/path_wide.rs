@@ -247,17 +247,10 @@ struct Lanes {
     beta_max: [f32; N],
 }
 
-/// `fast::sincos_2pi` (the same constants and operations) with its quadrant switch as selects.
+/// `fast::sincos_2pi` (its own polynomial parts) with the quadrant switch as selects.
 #[inline(always)]
 fn sincos_2pi(u: f32) -> (f32, f32) {
-    const ROUND: f32 = 12_582_912.0;
-    let t = u * 4.0 + ROUND;
-    let q = t - ROUND;
-    let quadrant = t.to_bits() & 3;
-    let x = (u - q * 0.25) * (2.0 * std::f32::consts::PI);
-    let x2 = x * x;
-    let s = ((-1.951_529_6e-4 * x2 + 8.332_161e-3) * x2 - 0.166_666_55) * x2 * x + x;
-    let c = ((2.443_315_7e-5 * x2 - 1.388_731_6e-3) * x2 + 4.166_664_6e-2) * (x2 * x2) - 0.5 * x2 + 1.0;
+    let (s, c, quadrant) = crate::math::fast::sincos_2pi_parts(u);
     // Quadrants 0..3: (s, c), (c, −s), (−s, −c), (−c, s).
     let odd = quadrant & 1 != 0;
     let (s1, c1) = (if odd { c } else { s }, if odd { -s } else { c });

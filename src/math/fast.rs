@@ -59,9 +59,11 @@ pub fn exp3(v: Vec3) -> Vec3 {
     v.exp()
 }
 
-/// `(sin 2πu, cos 2πu)` for `u` in [−1/8, 1] (a sampled angle as a fraction of a turn).
+/// The parts of [`sincos_2pi`] before its quadrant switch: `(sin, cos)` of the rest of `u` after
+/// its nearest quarter turn, and that quarter turn modulo 4. Shared with the lane-wise form in
+/// `integrator::path_wide`, which does the switch with selects.
 #[inline(always)]
-pub fn sincos_2pi(u: f32) -> (f32, f32) {
+pub fn sincos_2pi_parts(u: f32) -> (f32, f32, u32) {
     const ROUND: f32 = 12_582_912.0;
     // Nearest quarter turn q and the rest r in [−1/8, 1/8] (exact: u − q/4 is representable).
     let t = u * 4.0 + ROUND;
@@ -71,6 +73,13 @@ pub fn sincos_2pi(u: f32) -> (f32, f32) {
     let x2 = x * x;
     let s = ((-1.951_529_6e-4 * x2 + 8.332_161e-3) * x2 - 0.166_666_55) * x2 * x + x;
     let c = ((2.443_315_7e-5 * x2 - 1.388_731_6e-3) * x2 + 4.166_664_6e-2) * (x2 * x2) - 0.5 * x2 + 1.0;
+    (s, c, quadrant)
+}
+
+/// `(sin 2πu, cos 2πu)` for `u` in [−1/8, 1] (a sampled angle as a fraction of a turn).
+#[inline(always)]
+pub fn sincos_2pi(u: f32) -> (f32, f32) {
+    let (s, c, quadrant) = sincos_2pi_parts(u);
     match quadrant {
         0 => (s, c),
         1 => (c, -s),
