@@ -20,8 +20,23 @@ fn wide_path_matches_scalar_path_bit_for_bit() {
     let start = xml.find("<emitter").unwrap();
     let end = xml.find("</emitter>").unwrap() + "</emitter>".len();
     let dark = format!("{}{}", &xml[..start], &xml[end..]);
+    // `twosided` around diffuse with another model behind, on boxes whose normals point inward:
+    // the boxes are seen from their back sides (the wide loop's mirrored frame).
+    let two_sided = xml
+        .replace(
+            r#"<bsdf type="diffuse" id="white">
+        <rgb name="reflectance" value="0.73, 0.71, 0.68"/>
+    </bsdf>"#,
+            r#"<bsdf type="twosided" id="white">
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.73, 0.71, 0.68"/></bsdf>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.2, 0.5, 0.8"/></bsdf>
+    </bsdf>"#,
+        )
+        .replace(r#"<shape type="cube">"#, r#"<shape type="cube"><boolean name="flip_normals" value="true"/>"#);
+    assert!(two_sided.contains("twosided") && two_sided.contains("flip_normals"));
     let cancel = AtomicBool::new(false);
-    for (xml, max_depth) in [(&xml, "8"), (&xml, "-1"), (&hidden, "3"), (&dark, "8")] {
+    let mut images = Vec::new();
+    for (xml, max_depth) in [(&xml, "8"), (&xml, "-1"), (&hidden, "3"), (&dark, "8"), (&two_sided, "8")] {
         let scene = common::scene(xml, &[("width", "40"), ("height", "23"), ("max_depth", max_depth)]);
         for range in [None, Some((3, 7))] {
             let opts = RenderOptions { spp: Some(8), seed: 5, time_budget: None, progress: false };
@@ -37,6 +52,11 @@ fn wide_path_matches_scalar_path_bit_for_bit() {
             assert_eq!(wide.stats.rays, scalar.stats.rays);
             assert_eq!(wide.stats.rejected_samples, scalar.stats.rejected_samples);
             assert_eq!(wide.data.iter().any(|&x| x > 0.0), !std::ptr::eq(xml, &dark));
+            if max_depth == "8" && range.is_none() {
+                images.push(wide.data);
+            }
         }
     }
+    // The back sides' model shows: the two-sided image is not the one-sided one.
+    assert_ne!(images[0], images[2]);
 }

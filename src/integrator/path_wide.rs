@@ -1,5 +1,5 @@
 //! Mitsuba's `path` integrator on [`LANES`] pixels at once, for scenes whose every BSDF is `diffuse`
-//! (the same images as `path.rs`, bit for bit).
+//! or `twosided` around `diffuse` (the same images as `path.rs`, bit for bit).
 //!
 //! A lane is a pixel of the tile: it runs that pixel's samples one after the other from the
 //! pixel's own sampler stream, exactly as the scalar loop does, and when its pixel has done its
@@ -28,7 +28,7 @@
 
 use super::stats::LocalStats;
 use super::Integrator;
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, Diffuse};
 use crate::color::Spectrum;
 use crate::interaction::{offset_origin, DirectionSample};
 use crate::math::{mis_weight, Frame, Ray, Vec2, Vec3, INV_PI};
@@ -101,12 +101,26 @@ impl Pcg {
     }
 }
 
-/// True when the wide loop renders `scene` exactly: `path` (class AOVs off), every shape diffuse.
+/// True when the wide loop renders `scene` exactly: `path` (class AOVs off), every shape's BSDF
+/// diffuse or two-sided diffuse.
 pub fn applies(scene: &Scene) -> bool {
     ENABLED.load(Ordering::Relaxed)
         && matches!(scene.integrator, Integrator::Path(_))
         && !scene.integrator.classes
-        && scene.shapes.iter().all(|s| matches!(scene.bsdfs.get(s.bsdf as usize), Some(Bsdf::Diffuse(_))))
+        && scene.shapes.iter().all(|s| scene.bsdfs.get(s.bsdf as usize).is_some_and(|b| diffuse_sides(b).is_some()))
+}
+
+/// The diffuse models seen from the front and from the back of a `diffuse` BSDF (`None` behind:
+/// black there) or of a `twosided` one around two diffuse models; `None` for any other BSDF.
+fn diffuse_sides(bsdf: &Bsdf) -> Option<(&Diffuse, Option<&Diffuse>)> {
+    match bsdf {
+        Bsdf::Diffuse(d) => Some((d, None)),
+        Bsdf::TwoSided(front, back) => match (&**front, &**back) {
+            (Bsdf::Diffuse(f), Bsdf::Diffuse(b)) => Some((f, Some(b))),
+            _ => None,
+        },
+        _ => None,
+    }
 }
 
 /// Samples `0..replay + spp` of every pixel of `pixels` (the first `replay` counted in `replayed`
@@ -214,7 +228,10 @@ struct Lanes {
     frame_s: V3,
     frame_t: V3,
     frame_n: V3,
+    /// `wi.z` seen from the side whose model shades (`twosided::to_front`); `flip`: that is the
+    /// back side of a two-sided BSDF, so local directions are mirrored in z (`twosided::flip_z`).
     wi_z: [f32; N],
+    flip: [bool; N],
     reflectance: V3,
     /// Emitter sample: direction, solid-angle pdf, delta, weight; `nee`: pdf and weight non-zero.
     ds_d: V3,
@@ -256,6 +273,12 @@ fn sincos_2pi(u: f32) -> (f32, f32) {
     let (s1, c1) = (if odd { c } else { s }, if odd { -s } else { c });
     let half = quadrant & 2 != 0;
     (if half { -s1 } else { s1 }, if half { -c1 } else { c1 })
+}
+
+/// `twosided::flip_z` as a select: z negated (exact) where `flip`.
+#[inline(always)]
+fn flip_z(v: Vec3, flip: bool) -> Vec3 {
+    Vec3::new(v.x, v.y, if flip { -v.z } else { v.z })
 }
 
 /// `warp::square_to_cosine_hemisphere` (concentric disk, then lift) with its branches as selects.
@@ -345,7 +368,8 @@ fn shade(w: &mut Lanes) {
         let beta = w.beta.get(l);
 
         // ---- Emitter sampling: diffuse eval and pdf (`Diffuse::eval`, `Diffuse::pdf`) ----
-        let wo = frame.to_local(w.ds_d.get(l));
+        let flip = w.flip[l];
+        let wo = flip_z(frame.to_local(w.ds_d.get(l)), flip);
         let front = !(wi_z <= 0.0 || wo.z <= 0.0);
         let bsdf_val = if front { reflectance * (INV_PI * wo.z) } else { Spectrum::ZERO };
         let bsdf_pdf = if front { cosine_hemisphere_pdf(wo.z) } else { 0.0 };
@@ -365,7 +389,7 @@ fn shade(w: &mut Lanes) {
         w.beta.set(l, beta);
         w.beta_max[l] = beta.max_element();
         let p = w.p.get(l);
-        let wo_world = frame.to_world(wo);
+        let wo_world = frame.to_world(flip_z(wo, flip));
         w.ray_d.set(l, wo_world);
         w.ray_o.set(l, offset_origin(p, w.n.get(l), wo_world));
         w.prev_p.set(l, p);
@@ -530,14 +554,20 @@ fn render_impl(
                 finish!(l);
                 continue;
             }
-            let Bsdf::Diffuse(bsdf) = scene.bsdf(si) else { unreachable!("path_wide::applies checks every BSDF") };
+            let Some((front, back)) = diffuse_sides(scene.bsdf(si)) else {
+                unreachable!("path_wide::applies checks every BSDF")
+            };
+            // `twosided::to_front`: the back model shades a back-side hit, with wi mirrored.
+            let back_side = back.is_some() && si.wi.z.is_sign_negative();
+            let bsdf = if back_side { back.unwrap_or(front) } else { front };
             w.reflectance.set(l, bsdf.reflectance.eval(si.uv));
+            w.flip[l] = back_side;
             w.p.set(l, si.p);
             w.n.set(l, si.n);
             w.frame_s.set(l, si.sh_frame.s);
             w.frame_t.set(l, si.sh_frame.t);
             w.frame_n.set(l, si.sh_frame.n);
-            w.wi_z[l] = si.wi.z;
+            w.wi_z[l] = if back.is_some() { si.wi.z.abs() } else { si.wi.z };
             w.shading[l] = true;
             lanes[n_shade] = l;
             n_shade += 1;
