@@ -1,7 +1,8 @@
 //! The wide `path` loop (`integrator/path_wide.rs`, several pixels at once) renders the images of
 //! the scalar loop bit for bit: cornell_box (diffuse, a textured floor, an area light on a
 //! rectangle) on a film with partial tiles, whole and as a sample range that replays part of a
-//! chunk, with and without emitters hidden, and without emitters. Its own test binary: it flips the global switch.
+//! chunk, with and without emitters hidden, without emitters, and with two-sided boxes seen from
+//! behind. Its own test binary: it flips the global switch.
 
 mod common;
 
@@ -57,6 +58,7 @@ fn wide_path_matches_scalar_path_bit_for_bit() {
             }
         }
     }
-    // The back sides' model shows: the two-sided image is not the one-sided one.
+    // images: the one-sided, the dark and the two-sided scene at max_depth 8. The back sides'
+    // model shows: the two-sided image is not the one-sided one.
     assert_ne!(images[0], images[2]);
 }

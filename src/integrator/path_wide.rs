@@ -24,7 +24,7 @@
 //! scalar one bit for bit. Finished samples are buffered and splatted after the tile in the scalar
 //! order (pixel by pixel, samples in order), so the block sums are the scalar ones too
 //! (`tests/path_wide.rs`). Decided per render ([`applies`]): `path` without class AOVs, every
-//! shape's BSDF `diffuse`; every other scene keeps the scalar loop.
+//! shape's BSDF `diffuse` or `twosided` around `diffuse`; every other scene keeps the scalar loop.
 
 use super::stats::LocalStats;
 use super::Integrator;
@@ -558,8 +558,10 @@ fn render_impl(
                 unreachable!("path_wide::applies checks every BSDF")
             };
             // `twosided::to_front`: the back model shades a back-side hit, with wi mirrored.
-            let back_side = back.is_some() && si.wi.z.is_sign_negative();
-            let bsdf = if back_side { back.unwrap_or(front) } else { front };
+            let (bsdf, back_side) = match back {
+                Some(back) if si.wi.z.is_sign_negative() => (back, true),
+                _ => (front, false),
+            };
             w.reflectance.set(l, bsdf.reflectance.eval(si.uv));
             w.flip[l] = back_side;
             w.p.set(l, si.p);
@@ -567,7 +569,7 @@ fn render_impl(
             w.frame_s.set(l, si.sh_frame.s);
             w.frame_t.set(l, si.sh_frame.t);
             w.frame_n.set(l, si.sh_frame.n);
-            w.wi_z[l] = if back.is_some() { si.wi.z.abs() } else { si.wi.z };
+            w.wi_z[l] = if back_side { -si.wi.z } else { si.wi.z };
             w.shading[l] = true;
             lanes[n_shade] = l;
             n_shade += 1;
