@@ -205,6 +205,11 @@ fn forward_only(scene: &Scene) -> bool {
     matches!(&scene.integrator, Integrator::VolpathSnee(_, s) if s.forward_only)
 }
 
+/// Do camera beams run (`manifold/camera_beam.rs`: beams, a box-filtered pinhole in vacuum)?
+fn camera_beams(scene: &Scene) -> bool {
+    matches!(&scene.integrator, Integrator::VolpathSnee(_, s) if s.camera_beams && !s.forward_only)
+}
+
 /// Do beams run for some medium (`manifold/beam.rs`: `connection = complete`, `beams`, a
 /// directional light, a smooth dielectric boundary)?
 fn beams(scene: &Scene) -> bool {
@@ -260,6 +265,7 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
         integ_json["forward_only"] = json!(forward_only(scene));
         integ_json["split_glints"] = json!(split_glints(scene));
         integ_json["beams"] = json!(beams(scene));
+        integ_json["camera_beams"] = json!(camera_beams(scene));
     }
     let json = json!({
         "plugins": tree_json(&parsed.root, None),
@@ -324,6 +330,9 @@ pub fn summary(parsed: &ParsedScene, scene: &Scene) -> Summary {
             }
             if beams(scene) {
                 let _ = write!(text, ", beams (light-traced internal reflections)");
+            }
+            if camera_beams(scene) {
+                let _ = write!(text, ", camera beams (beam points splatted through one refraction)");
             }
         }
     }

@@ -305,6 +305,8 @@ pub fn render_range(
             return None;
         }
         let mut block = ImageBlock::new((x0, y0), (w, h), film.filter, nch);
+        // Light-tracing splats of this job's samples (`integrator::splat`).
+        crate::integrator::splat::open();
         let mut local = LocalStats::default();
         let mut replayed = LocalStats::default();
         let mut values = vec![0.0f32; nch];
@@ -361,11 +363,37 @@ pub fn render_range(
                 }
             }
         }
+        let splats = crate::integrator::splat::take();
         stats.add(&local);
         let n = w as u64 * h as u64 * pass_spp as u64;
         bar.inc(n);
-        Some((block, n))
+        Some((block, splats, n))
     };
+    // A splat's channels in `channels`' order, scaled by `1 / pixels` (one light subpath per
+    // camera sample, `integrator::splat`): value, no alpha, its square as second moment, and the
+    // class `internal_reflection`.
+    let splat_scale = 1.0 / pixels as f32;
+    let splat_values = |v: Spectrum, out: &mut Vec<f32>| {
+        let v = v * splat_scale;
+        out.clear();
+        out.extend(v.to_array());
+        if rgba {
+            out.push(0.0);
+        }
+        if moment {
+            out.extend((v * v).to_array());
+        }
+        if classes {
+            for class in 0..N_CLASSES {
+                let c = if class == PathClass::InternalReflection as usize { v } else { Spectrum::ZERO };
+                out.extend(c.to_array());
+                if moment {
+                    out.extend((c * c).to_array());
+                }
+            }
+        }
+    };
+    let mut splat_buf = Vec::with_capacity(nch);
 
     // Next sample index per pixel; the image holds samples start_sample..next.
     let mut next = start_sample;
@@ -414,7 +442,7 @@ pub fn render_range(
         // order; their blocks merge pass by pass in tile order, so the floating-point sums (and
         // so the image) do not depend on the thread count or on how passes were grouped.
         let nt = tiles.len();
-        let blocks: Vec<Option<(ImageBlock, u64)>> = (0..passes.len() * nt)
+        let blocks: Vec<Option<(ImageBlock, Vec<crate::integrator::splat::Splat>, u64)>> = (0..passes.len() * nt)
             .into_par_iter()
             .with_max_len(1)
             .map(|k| {
@@ -430,8 +458,12 @@ pub fn render_range(
                 stopped = true;
                 break;
             }
-            for (block, n) in pass_blocks.iter().flatten() {
+            for (block, splats, n) in pass_blocks.iter().flatten() {
                 full.merge(block);
+                for sp in splats {
+                    splat_values(sp.value, &mut splat_buf);
+                    full.add_unweighted(sp.pos.as_vec2(), &splat_buf);
+                }
                 samples_done += n;
             }
             pass_end = pass.2;

@@ -26,6 +26,7 @@ pub mod moment;
 pub mod path;
 pub mod path_wide;
 pub mod snee;
+pub mod splat;
 pub mod stats;
 pub mod technique;
 pub mod volpath;
@@ -173,6 +174,7 @@ impl Integrator {
                 // Glints (`manifold/glint.rs`): class `surface`.
                 let glint = manifold::glint::sample(scene, snee, sampler, &ray, stats);
                 tally.values[PathClass::Surface as usize] += glint;
+                manifold::camera_beam::sample(scene, snee, sampler, stats);
                 (l + glint, valid)
             }
         };

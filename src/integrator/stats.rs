@@ -98,4 +98,12 @@ counters! {
     beams,
     beam_connections,
     beam_blocked,
+    /// Camera beams (`manifold/camera_beam.rs`): points on beams connected to the camera, Newton
+    /// solves (one per point), the solves that did not converge, their iterations, and the
+    /// verified connections splatted.
+    camera_beam_points,
+    camera_beam_solves,
+    camera_beam_unsolved,
+    camera_beam_iterations,
+    camera_beam_splats,
 }

@@ -57,7 +57,10 @@ pub fn li(
     if !snee.has_directional {
         return (l, valid);
     }
-    (l + manifold::glint::sample(scene, snee, sampler, &ray, stats), valid)
+    let l = l + manifold::glint::sample(scene, snee, sampler, &ray, stats);
+    // Camera beams (docs/beams.md): splats into other pixels, none into this sample's value.
+    manifold::camera_beam::sample(scene, snee, sampler, stats);
+    (l, valid)
 }
 
 /// Has `scene` a `directional` emitter (the only emitters the camera's glints take)?
@@ -102,7 +105,8 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
     }
     let split_glints = props.bool("split_glints", true)?;
     let beams = props.bool("beams", true)?;
-    Ok(SneeOptions { technique, transport, rate, chains, connection_rate, split_glints, beams })
+    let camera_beams = props.bool("camera_beams", true)?;
+    Ok(SneeOptions { technique, transport, rate, chains, connection_rate, split_glints, beams, camera_beams })
 }
 
 /// The `connection` parameter (manifold NEE, `integrator/manifold/`).
@@ -135,6 +139,7 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
         snee.split = manifold::split::tables(scene, snee.options);
         if snee.options.beams && snee.options.keeps_all() && snee.has_directional {
             snee.beams = manifold::beam::beam_boundaries(scene);
+            snee.camera_beams = manifold::camera_beam::applies(scene, &snee);
         }
     }
     snee.forward_only = forward_only(scene, &snee, connection);

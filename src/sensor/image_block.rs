@@ -358,6 +358,26 @@ impl ImageBlock {
         }
     }
 
+    /// Add `values` to the pixel containing film position `pos` without a filter weight (a
+    /// light-tracing splat, `integrator::splat`: it adds to the pixel's weighted sum, and the
+    /// developed value is that sum over the camera samples' weight). Dropped outside the storage.
+    pub fn add_unweighted(&mut self, pos: Vec2, values: &[f32]) {
+        debug_assert_eq!(values.len(), self.channels, "ImageBlock::add_unweighted: wrong number of values");
+        if !pos.is_finite() {
+            return;
+        }
+        let (ox, oy) = self.storage_origin();
+        let (w, h) = self.storage_size();
+        let (x, y) = (floor_i64(pos.x).saturating_sub(ox), floor_i64(pos.y).saturating_sub(oy));
+        if x < 0 || y < 0 || x >= w as i64 || y >= h as i64 {
+            return;
+        }
+        let base = (y as usize * w + x as usize) * (self.channels + 1);
+        for (d, v) in self.data[base..base + self.channels].iter_mut().zip(values) {
+            *d += v;
+        }
+    }
+
     /// Add another block (a tile, border included) into this one where their storages overlap.
     /// Panics if the channel counts differ (a programming error, not a user error).
     pub fn merge(&mut self, other: &ImageBlock) {

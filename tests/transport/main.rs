@@ -7,6 +7,7 @@
 mod common;
 
 mod beams;
+mod camera_beams;
 mod glint;
 mod manifold_chain;
 mod manifold_curved;

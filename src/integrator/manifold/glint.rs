@@ -155,7 +155,7 @@ pub struct GlintMap {
 }
 
 /// Refraction of `d` into the surface at a point with outward shading normal `n`, `cos_1 = −d·n`.
-fn refract_in(d: DVec3, n: DVec3, cos_1: f64, eta: f64) -> Option<DVec3> {
+pub(super) fn refract_in(d: DVec3, n: DVec3, cos_1: f64, eta: f64) -> Option<DVec3> {
     let cos_t2 = 1.0 - (1.0 - cos_1 * cos_1) / (eta * eta);
     if !(cos_t2 > 0.0) {
         return None;
@@ -386,7 +386,7 @@ pub struct SceneGlint<'a> {
 }
 
 /// The patch of a medium's smooth dielectric boundary hit from outside along `d`, and the medium.
-fn outer_patch(scene: &Scene, si: &SurfaceInteraction, d: crate::math::Vec3) -> Option<(Patch, u32)> {
+pub(super) fn outer_patch(scene: &Scene, si: &SurfaceInteraction, d: crate::math::Vec3) -> Option<(Patch, u32)> {
     let medium = scene.shapes[si.shape as usize].interior?;
     // `boundary_patch` checks the side by the direction of travel from inside: use `−d`.
     Some((super::locate::boundary_patch(scene, si, medium, -d)?, medium))
@@ -412,7 +412,7 @@ impl GlintLocate for SceneGlint<'_> {
 }
 
 /// Does the renderer's own (f32) hit `si` agree with the solved point and shading normal?
-fn agrees(si: &SurfaceInteraction, x: DVec3, n_s: DVec3, t: f64) -> bool {
+pub(super) fn agrees(si: &SurfaceInteraction, x: DVec3, n_s: DVec3, t: f64) -> bool {
     (si.p.as_dvec3() - x).length() <= 1e-3 * (1.0 + t) && si.sh_frame.n.as_dvec3().dot(n_s) > 1.0 - 1e-4
 }
 

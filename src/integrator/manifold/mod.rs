@@ -36,6 +36,7 @@
 
 pub mod beam;
 pub mod beam_boundary;
+pub mod camera_beam;
 pub mod chain;
 pub mod chain_seed;
 pub mod curved;

@@ -70,6 +70,12 @@ pub struct ManifoldStage<'a> {
     medium_predecessor: bool,
     /// The beams of this path's light subpath (`beam.rs`), traced at its first vertex that needs them.
     beams: Option<BeamSet>,
+    /// Surfaces the path has reached, and medium vertices it has had.
+    surfaces: u32,
+    scatters: u32,
+    /// Is the current medium vertex the path's first, right after the camera ray's first surface
+    /// (a refraction in, `depth` 2)? Camera beams make the chain's paths from such vertices.
+    camera_first: bool,
 }
 
 impl<'a> ManifoldStage<'a> {
@@ -89,6 +95,9 @@ impl<'a> ManifoldStage<'a> {
             after_scatter: false,
             medium_predecessor: false,
             beams: None,
+            surfaces: 0,
+            scatters: 0,
+            camera_first: false,
         })
     }
 
@@ -98,16 +107,23 @@ impl<'a> ManifoldStage<'a> {
     pub fn at_scatter(&mut self, cx: &mut Cx, snee: &SneeStage, v: &Scatter) -> Spectrum {
         self.x_i = snee.chain_x_i().copied();
         self.medium_predecessor = std::mem::replace(&mut self.after_scatter, true);
+        self.camera_first = self.scatters == 0 && self.surfaces == 1 && v.depth == 2;
+        self.scatters += 1;
         self.tracker.sample(cx, self.snee.options, snee.chain_x_i(), v)
     }
 
     /// After [`Self::at_scatter`] at the same vertex: the two-vertex chain (`reflection_chains`,
     /// docs/manifold.md §9), returned apart so that the class tally counts it as internal reflection.
     /// Where beams run, the chain skips vertices whose predecessor is a medium vertex: the beams
-    /// connected at that predecessor make those paths (one reflection), so the two partition them.
+    /// connected at that predecessor make those paths (one reflection), so the two partition them;
+    /// where camera beams run, it also skips the camera's first medium vertex (`camera_beam.rs`).
     #[inline]
     pub fn chain_at_scatter(&mut self, cx: &mut Cx, v: &Scatter) -> Spectrum {
         if self.medium_predecessor && self.beams_apply(v.medium) {
+            return Spectrum::ZERO;
+        }
+        // Camera beams (`camera_beam.rs`) make the paths from the camera's first medium vertex.
+        if self.camera_first && self.snee.camera_beams && self.beams_apply(v.medium) {
             return Spectrum::ZERO;
         }
         super::sample_chain(cx, self.snee.options, v)
@@ -160,6 +176,7 @@ impl<'a> ManifoldStage<'a> {
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.after_scatter = false;
+        self.surfaces += si.is_some() as u32;
         shift(&mut self.arrived, &mut self.tracker.pending);
         shift(&mut self.rough_arrived, &mut self.rough_pending);
         shift(&mut self.curved_arrived, &mut self.curved_pending);

@@ -36,6 +36,9 @@ pub struct SneeOptions {
     /// `beams` (with `connection = complete`): light-traced internal-reflection segments under a
     /// directional light, connected to camera medium vertices (`manifold/beam.rs`).
     pub beams: bool,
+    /// `camera_beams` (with `connection = complete` and `beams`): light-traced beam points
+    /// connected to the camera through one refraction (`manifold/camera_beam.rs`).
+    pub camera_beams: bool,
 }
 
 impl Default for SneeOptions {
@@ -48,6 +51,7 @@ impl Default for SneeOptions {
             connection_rate: None,
             split_glints: true,
             beams: true,
+            camera_beams: true,
         }
     }
 }
@@ -103,6 +107,8 @@ pub struct Snee {
     /// With `connection = complete` and `beams`: per medium, the boundary where beams apply
     /// (`manifold::beam::beam_boundaries`); empty elsewhere.
     pub beams: Vec<Option<crate::integrator::manifold::beam_boundary::BeamBoundary>>,
+    /// Do camera beams run (`manifold::camera_beam::applies`, decided at load)?
+    pub camera_beams: bool,
 }
 
 /// Which estimator `volpath_snee` runs (`connection` parameter).

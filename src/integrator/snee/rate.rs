@@ -25,6 +25,7 @@ pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
         meter_glint: None,
         split: None,
         beams: Vec::new(),
+        camera_beams: false,
     }
 }
 
