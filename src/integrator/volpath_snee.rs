@@ -105,7 +105,7 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
     }
     let split_glints = props.bool("split_glints", true)?;
     let beams = props.bool("beams", true)?;
-    let camera_beams = props.bool("camera_beams", true)?;
+    let camera_beams = props.bool("camera_beams", false)?;
     Ok(SneeOptions { technique, transport, rate, chains, connection_rate, split_glints, beams, camera_beams })
 }
 

@@ -51,7 +51,7 @@ impl Default for SneeOptions {
             connection_rate: None,
             split_glints: true,
             beams: true,
-            camera_beams: true,
+            camera_beams: false,
         }
     }
 }
