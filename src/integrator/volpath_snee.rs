@@ -106,7 +106,25 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
     let split_glints = props.bool("split_glints", true)?;
     let beams = props.bool("beams", true)?;
     let camera_beams = props.bool("camera_beams", false)?;
-    Ok(SneeOptions { technique, transport, rate, chains, connection_rate, split_glints, beams, camera_beams })
+    let max = manifold::camera_beam::MAX_CAMERA_REFLECTIONS as i64;
+    let camera_reflections = props.int("camera_reflections", 0)?;
+    if !(0..=max).contains(&camera_reflections) {
+        return Err(
+            props.error("camera_reflections", format!("volpath_snee: camera_reflections must be in [0, {max}]"))
+        );
+    }
+    let camera_reflections = camera_reflections as u32;
+    Ok(SneeOptions {
+        technique,
+        transport,
+        rate,
+        chains,
+        connection_rate,
+        split_glints,
+        beams,
+        camera_beams,
+        camera_reflections,
+    })
 }
 
 /// The `connection` parameter (manifold NEE, `integrator/manifold/`).

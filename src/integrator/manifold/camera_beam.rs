@@ -1,53 +1,55 @@
-//! Camera beams: internal reflections of a directional light's beam, seen by the camera through
-//! ONE refraction with a single medium vertex on the path (`volpath_snee`, `connection =
-//! complete`, `camera_beams`; docs/beams.md, "Camera beams"):
+//! Camera beams: internal reflections of a directional light's beam whose only medium vertex is
+//! the camera path's first (`volpath_snee`, `connection = complete`, `camera_beams`, opt-in;
+//! docs/beams.md, "Camera beams"):
 //!
 //! ```text
-//! camera → x_c (refraction in) → x_b (medium vertex on a beam) → r_k … r_1 (reflections) → x_in → sun
+//! camera → x_c (refraction in) → [j internal reflections] → x_b (on a beam) → r_k … r_1 → x_in → sun
 //! ```
 //!
-//! Beams (`beam.rs`) make these paths only when `x_b`'s predecessor is a camera medium vertex;
-//! with `x_b` the camera path's FIRST vertex, `x_b` would have to lie on the camera ray (a set of
-//! measure zero), and the two-vertex chain of docs/manifold.md §9 finds them on the statue only
-//! with tiny probability (many solutions, tiny basins). Here the light side makes them: per
-//! camera sample one light subpath (`beam::trace`), on each reflected beam one point `x_b`
-//! (distance sampled in the medium's mean extinction, truncated to the beam), and the camera
-//! connection through the boundary solved in the FILM position `u` (2 unknowns): the pinhole ray
-//! through `u` refracts in at `x_c(u)` and must pass through `x_b`. The constraint is written on
-//! the plane through `x_b` perpendicular to a fixed direction `l` (as `newton_point.rs`):
+//! (`j` ≤ `camera_reflections`, default 0). Beams (`beam.rs`) make these paths only when `x_b`'s
+//! predecessor is a camera medium vertex; with `x_b` the camera path's FIRST vertex, `x_b` would
+//! have to lie on the camera ray (a set of measure zero), and the two-vertex chain of
+//! docs/manifold.md §9 finds them on the statue only with tiny probability. Here the light side
+//! makes them: per camera sample one light subpath (`beam::trace`), on each reflected beam one
+//! point `x_b` (distance sampled in the medium's mean extinction, truncated to the beam), and the
+//! camera connection through the boundary solved in the FILM position `u` (2 unknowns): the pinhole
+//! ray through `u` refracts in at `x_c(u)`, reflects `j` times, and its last segment (point `x_l`,
+//! direction `d_l`) must pass through `x_b`. The constraint is written on the plane through `x_b`
+//! perpendicular to a fixed direction `l` (as `newton_point.rs`):
 //!
 //! ```text
-//! Φ_l(u) = x_c + d_in · ((x_b − x_c)·l / (d_in·l)),   C(u) = P_l (Φ_l(u) − x_b) = 0
+//! Φ_l(u) = x_l + d_l · ((x_b − x_l)·l / (d_l·l)),   C(u) = P_l (Φ_l(u) − x_b) = 0
 //! ```
 //!
-//! At the solution, with `l = d_in`, `J = dC/du` is `dA⊥(x_b)/du` (area perpendicular to the
-//! refracted ray at `x_b` per pixel², a central difference of the closed-form patch map).
+//! At the solution, with `l = d_l`, `J = dC/du` is `dA⊥(x_b)/du` (area perpendicular to the last
+//! segment at `x_b` per pixel², a central difference of the closed-form patch map).
 //!
 //! **The value** (docs/beams.md derives it from the camera side's estimator): the pixel `P`
-//! holds `I_P = ∫_P du w(u) ∫ ds T(s) ε(x(u, s), −d_in)` with `w` the radiance-mode refraction
-//! weight `(1 − F) τ / η²`, `ε` the in-scattered emission; `dV = |det J| du ds`, and the beams
-//! estimate `∫ ε g dV` as `Σ_k Φ_k T(t) / p(t) · σ_s f_p · g` (photon beams). So one light
-//! subpath contributes, at the film position `u_s` of each solution,
+//! holds `I_P = ∫_P du w(u) ∫ ds T ε(x(u, s), −d_l)` with `w` the radiance-mode weights of the
+//! refraction (`(1 − F) τ / η²`) and reflections, `ε` the in-scattered emission; `dV = |det J| du
+//! ds`, and the beams estimate `∫ ε g dV` as `Σ_k Φ_k T(t) / p(t) · σ_s f_p · g` (photon beams).
+//! So one light subpath contributes, at the film position `u_s` of each solution,
 //!
 //! ```text
-//! C = Φ_k T(t)/p(t) · σ_s f_p(x_b; ω_bc, −d_k) · T(|x_b − x_c|) · w(x_c) / |det J|
+//! C = Φ_k T(t)/p(t) · σ_s f_p(x_b; ω_bc, −d_k) · T(x_c → x_b) · w / |det J|
 //! ```
 //!
 //! splatted (`integrator::splat`) and scaled by the render loop by `1 / pixels`.
 //!
-//! Seed: the film position of the straight line `camera → x_b`; one solve per point, so where
-//! several refraction solutions exist only the one Newton reaches from that seed is counted
-//! (a bias; on a convex boundary the solution is unique; `--stats` counts solves and splats).
-//! Weight 1: under a delta light behind a delta boundary no other technique of `complete` makes
-//! these paths except the optional chain, which skips the camera's first medium vertex wherever
-//! camera beams run (`ManifoldStage::chain_at_scatter`), so the two partition them.
+//! Seeds: the film position of the straight line `camera → x_b` and four points 4 px around it;
+//! every distinct converged solution counts once. Solutions no seed reaches are missing (a bias:
+//! on a convex boundary the refraction has one solution; on the statue more seeds keep finding
+//! more, docs/beams.md; `--stats` counts solves, failures and splats). Weight 1: under a delta
+//! light behind a delta boundary no other technique of `complete` makes these paths except the
+//! optional chain, which skips such first medium vertices wherever camera beams run
+//! (`ManifoldStage::chain_at_scatter`), so the two partition them.
 //!
 //! Scope: as the camera's glints (`glint::chains`): a `perspective` sensor in vacuum with a `box`
 //! filter, and the media where beams run (`Snee::beams`). The camera ray's first hit must be the
 //! boundary (a null surface in front of it is not handled).
 
 use super::beam::{self, Beam};
-use super::glint::{agrees, outer_patch, refract_in, CameraMap, GlintLocate, SceneGlint};
+use super::glint::{agrees, outer_patch, refract_in, CameraMap};
 use super::newton::{central_jacobian, tangents, Patch};
 use crate::bsdf::{flags, BsdfContext, TransportMode};
 use crate::color::Spectrum;
@@ -80,29 +82,106 @@ pub fn applies(scene: &Scene, snee: &Snee) -> bool {
         && snee.beams.iter().any(Option::is_some)
 }
 
-/// The refraction of the camera ray through film position `u` at patch `p1`: `(x_c, d_in, d)`,
-/// `d` the camera direction.
+/// Most internal reflections of the camera ray between its refraction in and `x_b` that the
+/// `camera_reflections` parameter may ask for.
+pub const MAX_CAMERA_REFLECTIONS: usize = 2;
+
+/// The located boundary patches of a camera chain: the refraction in at `x_c`, then `j` internal
+/// reflections.
+#[derive(Clone, Copy, Debug)]
+pub struct Chain {
+    pub p1: Patch,
+    pub refl: [Option<Patch>; MAX_CAMERA_REFLECTIONS],
+    pub j: usize,
+}
+
+/// The chain's closed-form map at film position `u` through its fixed patches.
+#[derive(Clone, Copy, Debug)]
+pub struct ChainMap {
+    /// Camera direction.
+    pub d: DVec3,
+    /// Refraction point and its outward shading normal, then the reflection points and normals.
+    pub x: [DVec3; MAX_CAMERA_REFLECTIONS + 1],
+    pub n: [DVec3; MAX_CAMERA_REFLECTIONS + 1],
+    /// Direction of the segment after the last interface (towards `x_b` at a solution).
+    pub dir: DVec3,
+    /// Inner length from `x_c` to the last interface.
+    pub len: f64,
+}
+
+/// A small step along `dir` from a point on the boundary (selects the far root on a sphere; the
+/// line is unchanged).
 #[inline]
-fn inner_line(p1: &Patch, cam: &CameraMap, u: DVec2) -> Option<(DVec3, DVec3, DVec3)> {
+fn nudge(x: DVec3) -> f64 {
+    1e-7 * (1.0 + x.abs().max_element())
+}
+
+/// The map of `chain` at `u`, or `None` when an interface is missed or met from the wrong side.
+pub fn chain_map(chain: &Chain, cam: &CameraMap, u: DVec2) -> Option<ChainMap> {
     let d = cam.direction(u);
-    let (_, x_c, n_c) = p1.hit(cam.origin, d)?;
+    let (_, x_c, n_c) = chain.p1.hit(cam.origin, d)?;
     let cos_1 = -d.dot(n_c);
     if !(cos_1 > 0.0) {
         return None;
     }
-    Some((x_c, refract_in(d, n_c, cos_1, p1.eta)?, d))
+    let mut dir = refract_in(d, n_c, cos_1, chain.p1.eta)?;
+    let mut m =
+        ChainMap { d, x: [x_c; MAX_CAMERA_REFLECTIONS + 1], n: [n_c; MAX_CAMERA_REFLECTIONS + 1], dir, len: 0.0 };
+    let mut at = x_c;
+    for i in 0..chain.j {
+        let q = chain.refl[i]?;
+        let e = nudge(at);
+        let (t, x, n) = q.hit(at + dir * e, dir)?;
+        let c = dir.dot(n);
+        if !(t > 0.0) || !(c > 0.0) {
+            return None;
+        }
+        m.len += t + e;
+        dir -= n * (2.0 * c);
+        at = x;
+        m.x[i + 1] = x;
+        m.n[i + 1] = n;
+    }
+    m.dir = dir;
+    Some(m)
 }
 
-/// `C(u)` in the tangent coordinates of `l` through the fixed patch `p1`.
+/// The chain's patches at `u`, located by ray casts in the scene (`j` internal reflections of the
+/// camera ray inside `medium`'s boundary, each the first hit of the previous segment).
+fn locate(scene: &Scene, cam: &CameraMap, u: DVec2, j: usize, medium: u32, rays: &mut u64) -> Option<Chain> {
+    let d = cam.direction(u);
+    *rays += 1;
+    let df = d.as_vec3().normalize();
+    let si = scene.ray_intersect(&Ray::new(cam.origin.as_vec3(), df))?;
+    let (p1, m) = outer_patch(scene, &si, df)?;
+    if m != medium {
+        return None;
+    }
+    let mut chain = Chain { p1, refl: [None; MAX_CAMERA_REFLECTIONS], j: 0 };
+    let mut n_geo = si.n;
+    for i in 0..j {
+        let map = chain_map(&chain, cam, u)?;
+        let (x, dir) = (map.x[i].as_vec3(), map.dir.as_vec3().normalize());
+        *rays += 1;
+        let hit = scene.ray_intersect(&Ray::new(offset_origin(x, n_geo, dir), dir))?;
+        chain.refl[i] = Some(super::locate::boundary_patch(scene, &hit, medium, dir)?);
+        chain.j = i + 1;
+        n_geo = hit.n;
+    }
+    Some(chain)
+}
+
+/// `C(u)` in the tangent coordinates of `l` through the fixed patches of `chain`.
 #[inline]
-fn residual(p1: &Patch, cam: &CameraMap, u: DVec2, x_b: DVec3, l: DVec3, lt: (DVec3, DVec3)) -> Option<[f64; 2]> {
-    let (x_c, d_in, _) = inner_line(p1, cam, u)?;
-    let denom = d_in.dot(l);
-    let s = (x_b - x_c).dot(l) / denom;
+fn residual(chain: &Chain, cam: &CameraMap, u: DVec2, x_b: DVec3, l: DVec3, lt: (DVec3, DVec3)) -> Option<[f64; 2]> {
+    let m = chain_map(chain, cam, u)?;
+    let last = m.x[chain.j];
+    let denom = m.dir.dot(l);
+    let s = (x_b - last).dot(l) / denom;
     if !(denom > 0.0) || !(s > 0.0) {
         return None;
     }
-    let v = x_c + d_in * s - x_b;
+    let v = last + m.dir * s - x_b;
     Some([v.dot(lt.0), v.dot(lt.1)])
 }
 
@@ -111,34 +190,37 @@ fn residual(p1: &Patch, cam: &CameraMap, u: DVec2, x_b: DVec3, l: DVec3, lt: (DV
 pub struct CameraSolution {
     /// Film position (pixels of the full film).
     pub u: DVec2,
-    /// Camera direction, refraction point, refracted direction (towards `x_b`).
-    pub d: DVec3,
-    pub x_c: DVec3,
-    pub d_in: DVec3,
+    pub chain: Chain,
+    pub map: ChainMap,
     /// `|det dA⊥(x_b)/du|`, m² per pixel².
     pub area_per_pixel: f64,
     pub iterations: u32,
 }
 
 /// Solve `C(u) = 0` from `seed` by damped Newton (steps halved until `|C|` decreases, at most 10
-/// halvings), relocating the patch by a ray cast at every accepted step.
-pub fn solve(locate: &mut impl GlintLocate, cam: &CameraMap, x_b: DVec3, seed: DVec2) -> (Option<CameraSolution>, u32) {
+/// halvings), the patches relocated by `relocate` at every accepted step.
+pub fn solve(
+    relocate: &mut impl FnMut(DVec2) -> Option<Chain>,
+    cam: &CameraMap,
+    x_b: DVec3,
+    seed: DVec2,
+) -> (Option<CameraSolution>, u32) {
     let tol = TOLERANCE * (x_b - cam.origin).length();
     let mut u = seed;
-    let Some((mut p1, _)) = locate.first(cam.origin, cam.direction(u)) else { return (None, 0) };
+    let Some(mut chain) = relocate(u) else { return (None, 0) };
     for it in 0..=MAX_ITERATIONS {
-        let Some((x_c, d_in, d)) = inner_line(&p1, cam, u) else { return (None, it) };
-        let (l, lt) = (d_in, tangents(d_in));
-        let Some(r) = residual(&p1, cam, u, x_b, l, lt) else { return (None, it) };
+        let Some(map) = chain_map(&chain, cam, u) else { return (None, it) };
+        let (l, lt) = (map.dir, tangents(map.dir));
+        let Some(r) = residual(&chain, cam, u, x_b, l, lt) else { return (None, it) };
         let norm = (r[0] * r[0] + r[1] * r[1]).sqrt();
-        let jac = |p1: &Patch| central_jacobian(FD_STEP, |a, b| residual(p1, cam, u + DVec2::new(a, b), x_b, l, lt));
-        let Some(j) = jac(&p1) else { return (None, it) };
+        let jac = central_jacobian(FD_STEP, |a, b| residual(&chain, cam, u + DVec2::new(a, b), x_b, l, lt));
+        let Some(j) = jac else { return (None, it) };
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
         if norm < tol {
             if !(det.abs() > 0.0 && det.is_finite()) {
                 return (None, it);
             }
-            let s = CameraSolution { u, d, x_c, d_in, area_per_pixel: det.abs(), iterations: it };
+            let s = CameraSolution { u, chain, map, area_per_pixel: det.abs(), iterations: it };
             return (Some(s), it);
         }
         if it == MAX_ITERATIONS || !(det.abs() > 1e-300) {
@@ -149,18 +231,18 @@ pub fn solve(locate: &mut impl GlintLocate, cam: &CameraMap, x_b: DVec3, seed: D
         let mut scale = 1.0;
         for _ in 0..10 {
             let cand = u + step * scale;
-            if let Some((p, _)) = locate.first(cam.origin, cam.direction(cand)) {
-                let better = residual(&p, cam, cand, x_b, l, lt).map(|c| (c[0] * c[0] + c[1] * c[1]).sqrt() < norm);
+            if let Some(c) = relocate(cand) {
+                let better = residual(&c, cam, cand, x_b, l, lt).map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt() < norm);
                 if better == Some(true) {
-                    accepted = Some((cand, p));
+                    accepted = Some((cand, c));
                     break;
                 }
             }
             scale *= 0.5;
         }
-        let Some((cand, p)) = accepted else { return (None, it + 1) };
+        let Some((cand, c)) = accepted else { return (None, it + 1) };
         u = cand;
-        p1 = p;
+        chain = c;
     }
     (None, MAX_ITERATIONS)
 }
@@ -181,9 +263,25 @@ fn beam_point(sigma_mean: f32, len: f32, v: f32) -> Option<(f32, f32)> {
     (pdf > 0.0 && pdf.is_finite()).then_some((t, 1.0 / pdf))
 }
 
+/// The dielectric's delta lobe `component` (0: reflection, 1: refraction) at `si` for the camera
+/// path arriving along `d` (radiance mode, as the camera path samples it): direction and weight.
+fn camera_lobe(scene: &Scene, si: &SurfaceInteraction, d: Vec3, component: u32) -> Option<(Vec3, Spectrum)> {
+    let local = SurfaceInteraction { wi: si.to_local(-d), ..*si };
+    let ctx = BsdfContext { mode: TransportMode::Radiance, type_mask: flags::ALL, component };
+    let (bs, weight) = scene.bsdf(&local).sample(&ctx, &local, 0.5, crate::math::Vec2::splat(0.5))?;
+    // The lobe leaves on the side it should, for the shading and the geometric normal.
+    let wo = local.to_world(bs.wo);
+    let reflect = component == 0;
+    let shading_ok = (bs.wo.z * local.wi.z > 0.0) == reflect;
+    let geometric_ok = (wo.dot(si.n) * (-d).dot(si.n) > 0.0) == reflect;
+    (shading_ok && geometric_ok && bs.wo.z != 0.0).then_some((wo, weight))
+}
+
 /// Verify a solution with the renderer's f32 rays (the camera ray's first hit is the boundary of
-/// `medium` at the solved point and normal, the refracted segment reaches `x_b` unblocked) and
-/// return the camera-side factor `w(x_c) T(s) / |det J|` and the direction `x_b → x_c`.
+/// `medium` at the solved point and normal, each reflection the first hit of the segment before
+/// it, the last segment reaches `x_b` unblocked) and return the camera-side factor
+/// `w T / |det J|` (`w`: the refraction's and reflections' radiance-mode weights, `T`: the
+/// transmittance from `x_c` to `x_b`) and the direction from `x_b` back along the last segment.
 fn verify(
     scene: &Scene,
     cam: &CameraMap,
@@ -192,33 +290,43 @@ fn verify(
     x_b: Vec3,
     stats: &mut LocalStats,
 ) -> Option<(Spectrum, Vec3)> {
-    let d = s.d.as_vec3().normalize();
+    let m = &s.map;
+    let mut d = m.d.as_vec3().normalize();
     stats.rays += 1;
-    let si = scene.ray_intersect(&Ray::new(cam.origin.as_vec3(), d))?;
-    let t_c = (s.x_c - cam.origin).length();
-    let (patch, m) = outer_patch(scene, &si, d)?;
-    let (_, _, n_s) = patch.hit(cam.origin, s.d)?;
-    if m != medium || !agrees(&si, s.x_c, n_s, t_c) {
+    let mut si = scene.ray_intersect(&Ray::new(cam.origin.as_vec3(), d))?;
+    let (_, hit_medium) = outer_patch(scene, &si, d)?;
+    if hit_medium != medium || !agrees(&si, m.x[0], m.n[0], (m.x[0] - cam.origin).length()) {
         return None;
     }
-    // The camera side's refraction, as the camera path samples it (radiance mode).
-    let (wi, d_in) = (si.to_local(-d), s.d_in.as_vec3().normalize());
-    let local = SurfaceInteraction { wi, ..si };
-    let ctx = BsdfContext { mode: TransportMode::Radiance, type_mask: flags::ALL, component: 1 };
-    let (bs, weight) = scene.bsdf(&local).sample(&ctx, &local, 0.5, crate::math::Vec2::splat(0.5))?;
-    let wo = local.to_world(bs.wo);
-    if !(wo.dot(d_in) > 1.0 - 1e-4) || !(d_in.dot(si.n) < 0.0) || !(bs.wo.z < 0.0) {
-        return None;
+    let mut weight = Spectrum::ONE;
+    for i in 0..=s.chain.j {
+        let (wo, w) = camera_lobe(scene, &si, d, if i == 0 { 1 } else { 0 })?;
+        let want = if i == s.chain.j { m.dir } else { m.x[i + 1] - m.x[i] }.as_vec3().normalize();
+        if !(wo.dot(want) > 1.0 - 1e-4) {
+            return None;
+        }
+        weight *= w;
+        d = wo;
+        if i < s.chain.j {
+            stats.rays += 1;
+            let next = scene.ray_intersect(&Ray::new(offset_origin(si.p, si.n, d), d))?;
+            let on = super::locate::boundary_patch(scene, &next, medium, d).is_some();
+            if !on || !agrees(&next, m.x[i + 1], m.n[i + 1], m.len) {
+                return None;
+            }
+            si = next;
+        }
     }
-    // The segment x_c → x_b inside the medium: its first hit lies beyond x_b.
-    let o = offset_origin(si.p, si.n, d_in);
+    // The last segment inside the medium: its first hit lies beyond x_b.
+    let o = offset_origin(si.p, si.n, d);
     let dist = (x_b - o).length();
     stats.rays += 1;
-    if scene.ray_intersect(&Ray::new(o, d_in)).is_some_and(|h| h.t < dist) {
+    if scene.ray_intersect(&Ray::new(o, d)).is_some_and(|h| h.t < dist) {
         return None;
     }
-    let tr = scene.media[medium as usize].transmittance((x_b - si.p).length());
-    Some((weight * tr * (1.0 / s.area_per_pixel) as f32, -d_in))
+    let length = m.len as f32 + (x_b - si.p).length();
+    let tr = scene.media[medium as usize].transmittance(length);
+    Some((weight * tr * (1.0 / s.area_per_pixel) as f32, -d))
 }
 
 /// Seeds of the camera solve, offsets (pixels) from the film position of the straight line
@@ -228,8 +336,9 @@ const SEED_OFFSETS: [(f64, f64); 5] = [(0.0, 0.0), (4.0, 0.0), (-4.0, 0.0), (0.0
 /// Two solutions closer than this on the film (pixels) are the same.
 const SAME_SOLUTION: f64 = 1e-3;
 
-/// One point on `beam` connected to the camera: a splat per distinct verified solution.
-fn connect(scene: &Scene, cam: &CameraMap, medium: u32, beam: &Beam, v: f32, stats: &mut LocalStats) {
+/// One point on `beam` connected to the camera through `j` internal reflections of the camera
+/// ray: a splat per distinct verified solution.
+fn connect(scene: &Scene, cam: &CameraMap, medium: u32, beam: &Beam, v: f32, j: usize, stats: &mut LocalStats) {
     let m = &scene.media[medium as usize];
     let sigma_mean = m.sigma_t.to_array().iter().sum::<f32>() / 3.0;
     let Some((t, inv_pdf)) = beam_point(sigma_mean, beam.len, v) else { return };
@@ -237,9 +346,10 @@ fn connect(scene: &Scene, cam: &CameraMap, medium: u32, beam: &Beam, v: f32, sta
     let Some(u0) = cam.film_position(x_b.as_dvec3() - cam.origin) else { return };
     let mut found: [Option<DVec2>; SEED_OFFSETS.len()] = [None; SEED_OFFSETS.len()];
     for (k, &(dx, dy)) in SEED_OFFSETS.iter().enumerate() {
-        let mut locate = SceneGlint { scene, rays: 0 };
-        let (sol, it) = solve(&mut locate, cam, x_b.as_dvec3(), u0 + DVec2::new(dx, dy));
-        stats.rays += locate.rays;
+        let mut rays = 0;
+        let mut relocate = |u: DVec2| locate(scene, cam, u, j, medium, &mut rays);
+        let (sol, it) = solve(&mut relocate, cam, x_b.as_dvec3(), u0 + DVec2::new(dx, dy));
+        stats.rays += rays;
         stats.camera_beam_solves += 1;
         stats.camera_beam_iterations += it as u64;
         let Some(s) = sol else {
@@ -275,14 +385,20 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, stats: &mut Loc
     for (medium, b) in snee.beams.iter().enumerate() {
         let Some(b) = b else { continue };
         let set = beam::trace(scene, medium as u32, b, sampler, stats);
+        let j_max = snee.options.camera_reflections as usize;
         for beam in set.beams() {
-            // Depth after the refraction out: x_c (1), x_b (2), k reflections, the refraction (3 + k).
+            // Depth after the refraction out: x_c (1), j reflections, x_b (2 + j), k reflections,
+            // the refraction out (3 + j + k).
             if 3 + beam.reflections >= max_depth {
                 continue;
             }
             let v = sampler.next_1d();
             stats.camera_beam_points += 1;
-            connect(scene, &cam, medium as u32, beam, v, stats);
+            for j in 0..=j_max.min(MAX_CAMERA_REFLECTIONS) {
+                if 3 + j as u32 + beam.reflections < max_depth {
+                    connect(scene, &cam, medium as u32, beam, v, j, stats);
+                }
+            }
         }
     }
 }
@@ -290,6 +406,87 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, stats: &mut Loc
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::manifold::newton::Surface;
+    use crate::math::DMat4;
+
+    fn ball() -> Patch {
+        Patch { surface: Surface::Sphere { center: DVec3::ZERO, radius: 1.0, outward: 1.0 }, eta: 1.5 }
+    }
+
+    /// A 48×64 camera at `(0.3, 0.5, 4)` looking at the unit ball (as `glint.rs`'s tests).
+    fn camera() -> CameraMap {
+        let origin = DVec3::new(0.3, 0.5, 4.0);
+        let dir = (DVec3::ZERO - origin).normalize();
+        let left = DVec3::Y.cross(dir).normalize();
+        let up = dir.cross(left);
+        let to_world = DMat4::from_cols(left.extend(0.0), up.extend(0.0), dir.extend(0.0), origin.extend(1.0));
+        let tan_half = (0.5f64 * 40f64.to_radians()).tan();
+        CameraMap {
+            origin,
+            to_world,
+            to_camera: to_world.inverse(),
+            film_size: DVec2::new(48.0, 64.0),
+            half_extent: DVec2::new(tan_half, tan_half * 64.0 / 48.0),
+            offset: DVec2::ZERO,
+        }
+    }
+
+    fn chain(j: usize) -> Chain {
+        Chain { p1: ball(), refl: [Some(ball()); MAX_CAMERA_REFLECTIONS], j }
+    }
+
+    /// On the ball, for `j` = 0, 1, 2 internal reflections and points `x_b` inside: the solution's
+    /// last segment passes through `x_b`, Snell's law holds at `x_c` and the law of reflection at
+    /// each reflection point, and `|det J|` equals the area ratio measured by re-solving for a
+    /// small square of points around `x_b` in the plane perpendicular to the last segment
+    /// (relative 1e-3).
+    #[test]
+    fn solutions_obey_the_interface_laws_and_the_area_ratio_matches_re_solving() {
+        let cam = camera();
+        let mut solved = 0;
+        for j in 0..=MAX_CAMERA_REFLECTIONS {
+            for x_b in [DVec3::new(0.1, -0.2, 0.3), DVec3::new(-0.4, 0.1, -0.2), DVec3::new(0.2, 0.5, 0.1)] {
+                let mut relocate = |_u: DVec2| Some(chain(j));
+                // Seeds over the film: keep the first that converges.
+                let seeds = (0..64).map(|i| DVec2::new(3.0 + 6.0 * (i % 8) as f64, 4.0 + 8.0 * (i / 8) as f64));
+                let Some(s) = seeds.filter_map(|u| solve(&mut relocate, &cam, x_b, u).0).next() else { continue };
+                solved += 1;
+                let m = s.map;
+                // The last segment passes through x_b.
+                let last = m.x[j];
+                let off = (x_b - last) - m.dir * (x_b - last).dot(m.dir);
+                assert!(off.length() < 1e-8, "j {j}: {off}");
+                // Snell at x_c: η sin θ_t = sin θ_i, in the plane of d and n.
+                let (d, n) = (m.d, m.n[0]);
+                let d_in = if j == 0 { m.dir } else { (m.x[1] - m.x[0]).normalize() };
+                let sin_i = d.cross(n).length();
+                let sin_t = d_in.cross(n).length();
+                assert!((1.5 * sin_t - sin_i).abs() < 1e-9, "Snell j {j}");
+                assert!(d.cross(n).dot(d_in.cross(n)) > 0.0, "refraction in the plane of incidence");
+                // Reflection at each x_{i+1}: incoming and outgoing mirror about n.
+                for i in 0..j {
+                    let w_in = (m.x[i + 1] - m.x[i]).normalize();
+                    let w_out = if i + 1 == j { m.dir } else { (m.x[i + 2] - m.x[i + 1]).normalize() };
+                    let n = m.n[i + 1];
+                    let mirrored = w_in - n * (2.0 * w_in.dot(n));
+                    assert!((mirrored - w_out).length() < 1e-9, "reflection j {j} i {i}");
+                }
+                // |det J| against re-solving for a square of side h around x_b.
+                let (t1, t2) = tangents(m.dir);
+                let h = 1e-5;
+                let mut corner = |a: f64, b: f64| {
+                    let y = x_b + t1 * a + t2 * b;
+                    solve(&mut relocate, &cam, y, s.u).0.expect("re-solve near the solution").u
+                };
+                let (u00, u10, u01) = (corner(0.0, 0.0), corner(h, 0.0), corner(0.0, h));
+                let (e1, e2) = (u10 - u00, u01 - u00);
+                let pixels = (e1.x * e2.y - e1.y * e2.x).abs();
+                let ratio = h * h / pixels;
+                assert!((ratio / s.area_per_pixel - 1.0).abs() < 1e-3, "j {j}: {ratio} vs {}", s.area_per_pixel);
+            }
+        }
+        assert!(solved >= 7, "solved {solved} of 9");
+    }
 
     /// The truncated exponential's density integrates to 1 over the beam and its samples follow
     /// it (χ² over 32 equal-probability bins, 10⁵ samples, below the 0.999 quantile of χ²(31) ≈ 61.1).

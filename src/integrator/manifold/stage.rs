@@ -73,8 +73,14 @@ pub struct ManifoldStage<'a> {
     /// Surfaces the path has reached, and medium vertices it has had.
     surfaces: u32,
     scatters: u32,
-    /// Is the current medium vertex the path's first, right after the camera ray's first surface
-    /// (a refraction in, `depth` 2)? Camera beams make the chain's paths from such vertices.
+    /// Before the first medium vertex: is the path so far a camera prefix that camera beams
+    /// connect (`camera_beam.rs`: a delta refraction into a medium's boundary, then delta
+    /// reflections on medium boundaries), and how many reflections has it had?
+    prefix_ok: bool,
+    prefix_entered: bool,
+    prefix_reflections: u32,
+    /// Is the current medium vertex the path's first, reached by such a prefix with at most
+    /// `camera_reflections` reflections? Camera beams make the chain's paths there.
     camera_first: bool,
 }
 
@@ -97,6 +103,9 @@ impl<'a> ManifoldStage<'a> {
             beams: None,
             surfaces: 0,
             scatters: 0,
+            prefix_ok: true,
+            prefix_entered: false,
+            prefix_reflections: 0,
             camera_first: false,
         })
     }
@@ -107,7 +116,13 @@ impl<'a> ManifoldStage<'a> {
     pub fn at_scatter(&mut self, cx: &mut Cx, snee: &SneeStage, v: &Scatter) -> Spectrum {
         self.x_i = snee.chain_x_i().copied();
         self.medium_predecessor = std::mem::replace(&mut self.after_scatter, true);
-        self.camera_first = self.scatters == 0 && self.surfaces == 1 && v.depth == 2;
+        // No null crossing (`depth` counts the non-null events, `surfaces` every hit).
+        self.camera_first = self.scatters == 0
+            && self.prefix_ok
+            && self.prefix_entered
+            && self.prefix_reflections <= self.snee.options.camera_reflections
+            && v.depth == self.surfaces + 1
+            && v.depth == 2 + self.prefix_reflections;
         self.scatters += 1;
         self.tracker.sample(cx, self.snee.options, snee.chain_x_i(), v)
     }
@@ -222,6 +237,9 @@ impl<'a> ManifoldStage<'a> {
     /// (The pending records are empty here: [`Self::at_surface`] moved them to the arrived ones.)
     #[inline]
     pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
+        if self.scatters == 0 && self.prefix_ok {
+            self.track_prefix(scene, s, bs);
+        }
         debug_assert!(self.rough_pending.is_none() && self.curved_pending.is_none() && self.tracker.pending.is_none());
         let x_j = self.tracker.x_j.take();
         // Nothing to start (no `x_j`) nor to carry: every crossing leaves the records empty.
@@ -229,6 +247,21 @@ impl<'a> ManifoldStage<'a> {
             return;
         }
         self.records_after_bsdf(scene, s, bs, wo, x_j);
+    }
+
+    /// The camera prefix before the first medium vertex (`camera_first`).
+    fn track_prefix(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample) {
+        use crate::bsdf::flags;
+        let t = bs.sampled_type;
+        let boundary = scene.shapes[s.shape as usize].interior.is_some() && t & flags::NULL == 0;
+        if !self.prefix_entered {
+            self.prefix_entered = true;
+            self.prefix_ok = boundary && t & flags::DELTA_TRANSMISSION != 0;
+        } else if boundary && t & flags::DELTA_REFLECTION != 0 {
+            self.prefix_reflections += 1;
+        } else {
+            self.prefix_ok = false;
+        }
     }
 
     /// [`Self::after_bsdf`] where `x_j` (taken) or a record that arrived is there.

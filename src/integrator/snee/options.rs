@@ -39,6 +39,9 @@ pub struct SneeOptions {
     /// `camera_beams` (with `connection = complete` and `beams`): light-traced beam points
     /// connected to the camera through one refraction (`manifold/camera_beam.rs`).
     pub camera_beams: bool,
+    /// `camera_reflections` ∈ {0, 1, 2}: internal reflections of the camera ray before `x_b`
+    /// that camera beams connect through (`manifold/camera_beam.rs`).
+    pub camera_reflections: u32,
 }
 
 impl Default for SneeOptions {
@@ -52,6 +55,7 @@ impl Default for SneeOptions {
             split_glints: true,
             beams: true,
             camera_beams: false,
+            camera_reflections: 0,
         }
     }
 }
