@@ -87,3 +87,83 @@ fn camera_beams_match_the_chain_from_the_first_medium_vertex() {
     }
     assert!(stats_on > 0 && splats > 0, "camera beams ran: {stats_on} points, {splats} splats");
 }
+
+/// A diagnosis, not a check: on the statue, points `x_b` made from known camera solutions (the
+/// pinhole ray through a film position `u_0` refracted in and followed a random fraction of the way
+/// to the next boundary hit), solved from the straight-line seed as the renderer does: how often
+/// Newton converges, and to `u_0`. `cargo test --release --test transport diagnose_camera_solves
+/// -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn diagnose_camera_solves_on_the_statue() {
+    use snee::integrator::manifold::camera_beam::{locate, solve};
+    use snee::integrator::manifold::glint::CameraMap;
+    use snee::math::Ray;
+    use snee::sampler::Sampler;
+    let file = common::root().join("scenes/paper/directional_smooth_st02.xml");
+    let defines = vec![("width".to_string(), "48".to_string()), ("height".to_string(), "64".to_string())];
+    let scene = snee::scene::build::build_scene(&snee::scene::xml::parse_file(&file, &defines).unwrap()).unwrap();
+    let snee::sensor::Camera::Perspective(p) = &scene.camera else { panic!("perspective") };
+    let cam = CameraMap::new(p, scene.film.width, scene.film.height);
+    let mut rng = Sampler::new(3, 9);
+    use snee::integrator::manifold::{locate::SceneLocate, newton_point};
+    let (mut tried, mut converged, mut same) = (0, 0, 0);
+    let (mut light_found, mut light_same, mut light_solutions) = (0, 0, 0);
+    let (mut ring_same, mut both_same) = (0, 0);
+    let mut iters = Vec::new();
+    for _ in 0..4000 {
+        let u0 = glam::DVec2::new(rng.next_1d() as f64 * 48.0, rng.next_1d() as f64 * 64.0);
+        let mut rays = 0;
+        let Some(chain) = locate(&scene, &cam, u0, 0, 0, &mut rays) else { continue };
+        let Some(m) = snee::integrator::manifold::camera_beam::chain_map(&chain, &cam, u0) else { continue };
+        let d = m.dir.as_vec3().normalize();
+        let o = m.x[0].as_vec3() + d * 1e-3;
+        let Some(hit) = scene.ray_intersect(&Ray::new(o, d)) else { continue };
+        let x_b = m.x[0] + m.dir * ((hit.t as f64) * rng.next_1d() as f64);
+        let seed = cam.film_position(x_b - cam.origin).unwrap();
+        tried += 1;
+        let mut relocate = |u| locate(&scene, &cam, u, 0, 0, &mut rays);
+        let (s, it) = solve(&mut relocate, &cam, x_b, seed);
+        iters.push(it);
+        if let Some(s) = s {
+            converged += 1;
+            if (s.u - u0).length() < 1e-3 {
+                same += 1;
+            }
+        }
+        // The light side's procedure (newton_point, 20 seeds from x_b towards the pinhole), its
+        // solutions' film positions used as seeds of the camera-side solve.
+        let mut loc = SceneLocate { scene: &scene, medium: 0, rays: 0 };
+        let first = newton_point::seed_line(&mut loc, x_b, cam.origin).1;
+        let found = newton_point::solve_distinct(&mut loc, x_b, cam.origin, first, newton_point::SEEDS);
+        let mut any = false;
+        for sol in &found.solutions {
+            light_solutions += 1;
+            let x_k = sol.refracted.x_k;
+            let Some(u) = cam.film_position(x_k - cam.origin) else { continue };
+            if let (Some(s), _) = solve(&mut relocate, &cam, x_b, u) {
+                if (s.u - u0).length() < 1e-3 {
+                    any = true;
+                }
+            }
+        }
+        light_found += !found.solutions.is_empty() as u32;
+        light_same += any as u32;
+        let mut ring = false;
+        for (dx, dy) in [(0.0, 0.0), (4.0, 0.0), (-4.0, 0.0), (0.0, 4.0), (0.0, -4.0)] {
+            if let (Some(s), _) = solve(&mut relocate, &cam, x_b, seed + glam::DVec2::new(dx, dy)) {
+                ring |= (s.u - u0).length() < 1e-3;
+            }
+        }
+        ring_same += ring as u32;
+        both_same += (ring || any) as u32;
+    }
+    eprintln!("light side: points with a solution {light_found}, with u_0 among them {light_same}, solutions {light_solutions}");
+    eprintln!("u_0 found by the five film seeds {ring_same}, by either {both_same}");
+    iters.sort();
+    eprintln!(
+        "tried {tried}, converged {converged}, to u_0 {same}; iterations median {} p90 {}",
+        iters[iters.len() / 2],
+        iters[iters.len() * 9 / 10]
+    );
+}

@@ -50,7 +50,9 @@
 
 use super::beam::{self, Beam};
 use super::glint::{agrees, outer_patch, refract_in, CameraMap};
+use super::locate::SceneLocate;
 use super::newton::{central_jacobian, tangents, Patch};
+use super::newton_point;
 use crate::bsdf::{flags, BsdfContext, TransportMode};
 use crate::color::Spectrum;
 use crate::integrator::snee::Snee;
@@ -148,7 +150,7 @@ pub fn chain_map(chain: &Chain, cam: &CameraMap, u: DVec2) -> Option<ChainMap> {
 
 /// The chain's patches at `u`, located by ray casts in the scene (`j` internal reflections of the
 /// camera ray inside `medium`'s boundary, each the first hit of the previous segment).
-fn locate(scene: &Scene, cam: &CameraMap, u: DVec2, j: usize, medium: u32, rays: &mut u64) -> Option<Chain> {
+pub fn locate(scene: &Scene, cam: &CameraMap, u: DVec2, j: usize, medium: u32, rays: &mut u64) -> Option<Chain> {
     let d = cam.direction(u);
     *rays += 1;
     let df = d.as_vec3().normalize();
@@ -344,11 +346,24 @@ fn connect(scene: &Scene, cam: &CameraMap, medium: u32, beam: &Beam, v: f32, j: 
     let Some((t, inv_pdf)) = beam_point(sigma_mean, beam.len, v) else { return };
     let x_b = beam.o + beam.d * t;
     let Some(u0) = cam.film_position(x_b.as_dvec3() - cam.origin) else { return };
-    let mut found: [Option<DVec2>; SEED_OFFSETS.len()] = [None; SEED_OFFSETS.len()];
-    for (k, &(dx, dy)) in SEED_OFFSETS.iter().enumerate() {
+    let mut seeds: Vec<DVec2> = SEED_OFFSETS.iter().map(|&(dx, dy)| u0 + DVec2::new(dx, dy)).collect();
+    if j == 0 {
+        // The light side's seeds: the film positions of the solutions of the point connection's
+        // deterministic procedure from x_b towards the pinhole (`newton_point`, docs/manifold.md §8.2).
+        let mut loc = SceneLocate { scene, medium, rays: 0 };
+        let (xb, y) = (x_b.as_dvec3(), cam.origin);
+        let first = newton_point::seed_line(&mut loc, xb, y).1;
+        let light = newton_point::solve_distinct(&mut loc, xb, y, first, newton_point::SEEDS);
+        stats.rays += loc.rays;
+        stats.camera_beam_solves += light.solves as u64;
+        stats.camera_beam_iterations += light.iterations as u64;
+        seeds.extend(light.solutions.iter().filter_map(|s| cam.film_position(s.refracted.x_k - cam.origin)));
+    }
+    let mut found: Vec<DVec2> = Vec::with_capacity(seeds.len());
+    for seed in seeds {
         let mut rays = 0;
         let mut relocate = |u: DVec2| locate(scene, cam, u, j, medium, &mut rays);
-        let (sol, it) = solve(&mut relocate, cam, x_b.as_dvec3(), u0 + DVec2::new(dx, dy));
+        let (sol, it) = solve(&mut relocate, cam, x_b.as_dvec3(), seed);
         stats.rays += rays;
         stats.camera_beam_solves += 1;
         stats.camera_beam_iterations += it as u64;
@@ -356,10 +371,10 @@ fn connect(scene: &Scene, cam: &CameraMap, medium: u32, beam: &Beam, v: f32, j: 
             stats.camera_beam_unsolved += 1;
             continue;
         };
-        if found.iter().flatten().any(|u| (*u - s.u).length() < SAME_SOLUTION) {
+        if found.iter().any(|u| (*u - s.u).length() < SAME_SOLUTION) {
             continue;
         }
-        found[k] = Some(s.u);
+        found.push(s.u);
         let Some((camera_side, w_bc)) = verify(scene, cam, medium, &s, x_b, stats) else { continue };
         let f_p = m.phase.eval(w_bc, -beam.d);
         let value = beam.flux * m.transmittance(t) * m.sigma_s() * camera_side * (f_p * inv_pdf);
