@@ -110,6 +110,7 @@ fn diagnose_camera_solves_on_the_statue() {
     let (mut tried, mut converged, mut same) = (0, 0, 0);
     let (mut light_found, mut light_same, mut light_solutions) = (0, 0, 0);
     let (mut ring_same, mut both_same) = (0, 0);
+    let (mut basin, mut missed, mut depth_missed, mut depth_found) = ([0u32; 4], 0, 0.0, 0.0);
     let mut iters = Vec::new();
     for _ in 0..4000 {
         let u0 = glam::DVec2::new(rng.next_1d() as f64 * 48.0, rng.next_1d() as f64 * 64.0);
@@ -157,9 +158,32 @@ fn diagnose_camera_solves_on_the_statue() {
         }
         ring_same += ring as u32;
         both_same += (ring || any) as u32;
+        if !(ring || any) {
+            // How far around u_0 its basin reaches: solves from 8 points on circles of radius r.
+            for (k, r) in [0.1f64, 0.5, 2.0, 8.0].iter().enumerate() {
+                for i in 0..8 {
+                    let a = std::f64::consts::TAU * i as f64 / 8.0;
+                    let seed = u0 + glam::DVec2::new(a.cos(), a.sin()) * *r;
+                    if let (Some(s), _) = solve(&mut relocate, &cam, x_b, seed) {
+                        basin[k] += ((s.u - u0).length() < 1e-3) as u32;
+                    }
+                }
+            }
+            missed += 1;
+            depth_missed += (x_b - m.x[0]).length();
+        } else {
+            depth_found += (x_b - m.x[0]).length();
+        }
     }
     eprintln!("light side: points with a solution {light_found}, with u_0 among them {light_same}, solutions {light_solutions}");
     eprintln!("u_0 found by the five film seeds {ring_same}, by either {both_same}");
+    eprintln!(
+        "missed {missed}: of 8 seeds at 0.1 / 0.5 / 2 / 8 px from u_0, converging to it {:?} (of {}); mean depth of x_b missed {:.3}, found {:.3}",
+        basin,
+        8 * missed,
+        depth_missed / missed.max(1) as f64,
+        depth_found / both_same.max(1) as f64
+    );
     iters.sort();
     eprintln!(
         "tried {tried}, converged {converged}, to u_0 {same}; iterations median {} p90 {}",

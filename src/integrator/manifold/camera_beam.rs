@@ -36,10 +36,13 @@
 //!
 //! splatted (`integrator::splat`) and scaled by the render loop by `1 / pixels`.
 //!
-//! Seeds: the film position of the straight line `camera → x_b` and four points 4 px around it;
-//! every distinct converged solution counts once. Solutions no seed reaches are missing (a bias:
-//! on a convex boundary the refraction has one solution; on the statue more seeds keep finding
-//! more, docs/beams.md; `--stats` counts solves, failures and splats). Weight 1: under a delta
+//! Seeds: the film position of the straight line `camera → x_b`; on a curved boundary also four
+//! points 4 px around it and (with no camera reflection) the film positions of the solutions of
+//! the point connection's deterministic procedure from `x_b` towards the pinhole
+//! (`newton_point::solve_distinct`); every distinct converged solution counts once. Solutions no
+//! seed reaches are missing (a bias: on a flat or convex boundary the refraction has one solution;
+//! on the statue about half of the class is found, docs/beams.md; `--stats` counts solves,
+//! failures and splats). Weight 1: under a delta
 //! light behind a delta boundary no other technique of `complete` makes these paths except the
 //! optional chain, which skips such first medium vertices wherever camera beams run
 //! (`ManifoldStage::chain_at_scatter`), so the two partition them.
@@ -340,14 +343,27 @@ const SAME_SOLUTION: f64 = 1e-3;
 
 /// One point on `beam` connected to the camera through `j` internal reflections of the camera
 /// ray: a splat per distinct verified solution.
-fn connect(scene: &Scene, cam: &CameraMap, medium: u32, beam: &Beam, v: f32, j: usize, stats: &mut LocalStats) {
+/// `curved`: the boundary is curved (`Snee::curved`); on a flat one the straight-line seed alone
+/// (its solution is unique there, and the other seeds found none more on the cube of docs/beams.md).
+#[allow(clippy::too_many_arguments)]
+fn connect(
+    scene: &Scene,
+    cam: &CameraMap,
+    medium: u32,
+    curved: bool,
+    beam: &Beam,
+    v: f32,
+    j: usize,
+    stats: &mut LocalStats,
+) {
     let m = &scene.media[medium as usize];
     let sigma_mean = m.sigma_t.to_array().iter().sum::<f32>() / 3.0;
     let Some((t, inv_pdf)) = beam_point(sigma_mean, beam.len, v) else { return };
     let x_b = beam.o + beam.d * t;
     let Some(u0) = cam.film_position(x_b.as_dvec3() - cam.origin) else { return };
-    let mut seeds: Vec<DVec2> = SEED_OFFSETS.iter().map(|&(dx, dy)| u0 + DVec2::new(dx, dy)).collect();
-    if j == 0 {
+    let offsets = if curved { &SEED_OFFSETS[..] } else { &SEED_OFFSETS[..1] };
+    let mut seeds: Vec<DVec2> = offsets.iter().map(|&(dx, dy)| u0 + DVec2::new(dx, dy)).collect();
+    if j == 0 && curved {
         // The light side's seeds: the film positions of the solutions of the point connection's
         // deterministic procedure from x_b towards the pinhole (`newton_point`, docs/manifold.md §8.2).
         let mut loc = SceneLocate { scene, medium, rays: 0 };
@@ -401,6 +417,7 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, stats: &mut Loc
         let Some(b) = b else { continue };
         let set = beam::trace(scene, medium as u32, b, sampler, stats);
         let j_max = snee.options.camera_reflections as usize;
+        let curved = snee.curved.get(medium).copied().unwrap_or(true);
         for beam in set.beams() {
             // Depth after the refraction out: x_c (1), j reflections, x_b (2 + j), k reflections,
             // the refraction out (3 + j + k).
@@ -411,7 +428,7 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, stats: &mut Loc
             stats.camera_beam_points += 1;
             for j in 0..=j_max.min(MAX_CAMERA_REFLECTIONS) {
                 if 3 + j as u32 + beam.reflections < max_depth {
-                    connect(scene, &cam, medium as u32, beam, v, j, stats);
+                    connect(scene, &cam, medium as u32, curved, beam, v, j, stats);
                 }
             }
         }
