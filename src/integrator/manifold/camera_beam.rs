@@ -438,29 +438,11 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, stats: &mut Loc
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::manifold::glint::tests::camera;
     use crate::integrator::manifold::newton::Surface;
-    use crate::math::DMat4;
 
     fn ball() -> Patch {
         Patch { surface: Surface::Sphere { center: DVec3::ZERO, radius: 1.0, outward: 1.0 }, eta: 1.5 }
-    }
-
-    /// A 48×64 camera at `(0.3, 0.5, 4)` looking at the unit ball (as `glint.rs`'s tests).
-    fn camera() -> CameraMap {
-        let origin = DVec3::new(0.3, 0.5, 4.0);
-        let dir = (DVec3::ZERO - origin).normalize();
-        let left = DVec3::Y.cross(dir).normalize();
-        let up = dir.cross(left);
-        let to_world = DMat4::from_cols(left.extend(0.0), up.extend(0.0), dir.extend(0.0), origin.extend(1.0));
-        let tan_half = (0.5f64 * 40f64.to_radians()).tan();
-        CameraMap {
-            origin,
-            to_world,
-            to_camera: to_world.inverse(),
-            film_size: DVec2::new(48.0, 64.0),
-            half_extent: DVec2::new(tan_half, tan_half * 64.0 / 48.0),
-            offset: DVec2::ZERO,
-        }
     }
 
     fn chain(j: usize) -> Chain {

@@ -515,7 +515,7 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, ray: &Ray, stat
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::integrator::manifold::newton::Surface;
 
@@ -542,8 +542,8 @@ mod tests {
         }
     }
 
-    /// A 48×64 camera at `(0.3, 0.5, 4)` looking at the ball.
-    fn camera() -> CameraMap {
+    /// A 48×64 camera at `(0.3, 0.5, 4)` looking at the ball (also `camera_beam.rs`'s tests').
+    pub(in crate::integrator::manifold) fn camera() -> CameraMap {
         // Mitsuba's `lookat`: columns left, up, forward, origin.
         let origin = DVec3::new(0.3, 0.5, 4.0);
         let dir = (DVec3::ZERO - origin).normalize();
