@@ -352,9 +352,12 @@ pub fn render_range(
             for y in y0..y0 + h as i32 {
                 for x in x0..x0 + w as i32 {
                     let mut sampler = Sampler::new(opts.seed, stream_at(x, y));
+                    // Replayed samples belong to another range: their splats are dropped.
+                    let kept = crate::integrator::splat::len();
                     for _ in 0..replay {
                         take_sample(&mut sampler, &mut replayed, x, y, classes.then_some(&mut split));
                     }
+                    crate::integrator::splat::truncate(kept);
                     for _ in 0..pass_spp {
                         let (pos, l, valid) =
                             take_sample(&mut sampler, &mut local, x, y, classes.then_some(&mut split));

@@ -38,6 +38,21 @@ pub fn take() -> Vec<Splat> {
     COLLECTOR.with(|c| c.borrow_mut().take()).unwrap_or_default()
 }
 
+/// How many splats this thread's collector holds (0 when none is open).
+pub fn len() -> usize {
+    COLLECTOR.with(|c| c.borrow().as_ref().map_or(0, Vec::len))
+}
+
+/// Drop this thread's splats after the first `n`: those of samples that were only replayed (to
+/// bring a pixel's stream to the start of a sample range), which belong to another range.
+pub fn truncate(n: usize) {
+    COLLECTOR.with(|c| {
+        if let Some(v) = c.borrow_mut().as_mut() {
+            v.truncate(n);
+        }
+    });
+}
+
 /// Add a splat to this thread's collector (dropped when none is open).
 pub fn push(s: Splat) {
     COLLECTOR.with(|c| {
