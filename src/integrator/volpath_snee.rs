@@ -114,6 +114,7 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
         );
     }
     let camera_reflections = camera_reflections as u32;
+    let inner_glints = props.bool("inner_glints", false)?;
     Ok(SneeOptions {
         technique,
         transport,
@@ -124,6 +125,7 @@ pub fn parse_options(props: &Props) -> Result<SneeOptions> {
         beams,
         camera_beams,
         camera_reflections,
+        inner_glints,
     })
 }
 

@@ -78,6 +78,9 @@ pub enum Chain {
     Reflect,
     /// Refraction in at `x_1`, a straight segment through the medium, refraction out at `x_2`.
     Through,
+    /// Refraction in at `x_1`, an internal reflection at `x_2`, refraction out at `x_3`, no
+    /// collision on either segment (`inner_glints`).
+    Inside,
 }
 
 /// The pinhole camera's map from film positions (pixels of the full film) to world directions,
@@ -148,7 +151,11 @@ pub struct GlintMap {
     pub cos_1: f64,
     /// Direction after `x_1`: reflected (outside) or refracted (inside).
     pub d_1: DVec3,
-    /// The refraction out at `x_2` (`Through`; `t`: distance `x_1 → x_2`).
+    /// `Inside`: the internal reflection at `x_2`: point, outward shading normal, distance
+    /// `x_1 → x_2`, `cos_2 = d_1 · n_2 > 0`.
+    pub refl: Option<(DVec3, DVec3, f64, f64)>,
+    /// The refraction out at the last interface (`Through`: `x_2`, `t` the distance `x_1 → x_2`;
+    /// `Inside`: `x_3`, `t` the distance `x_2 → x_3`).
     pub out: Option<Refracted>,
     /// Outgoing direction (towards the light at a solution).
     pub o: DVec3,
@@ -164,9 +171,17 @@ pub(super) fn refract_in(d: DVec3, n: DVec3, cos_1: f64, eta: f64) -> Option<DVe
     Some((d / eta + n * (cos_1 / eta - cos_t2.sqrt())).normalize())
 }
 
-/// The chain through `p1` (and `p2` for `Through`) along the camera direction `d`, or `None`
-/// when `d` meets `p1` from inside, or the refraction is total, or `p2` is met from outside.
-pub fn glint_map(chain: Chain, p1: &Patch, p2: Option<&Patch>, c: DVec3, d: DVec3) -> Option<GlintMap> {
+/// The chain through `p1` (and `p2` for `Through`, `p2` then `p3` for `Inside`) along the camera
+/// direction `d`, or `None` when `d` meets `p1` from inside, or a refraction is total, or a later
+/// patch is met from outside.
+pub fn glint_map(
+    chain: Chain,
+    p1: &Patch,
+    p2: Option<&Patch>,
+    p3: Option<&Patch>,
+    c: DVec3,
+    d: DVec3,
+) -> Option<GlintMap> {
     let (_, x_1, n_1) = p1.hit(c, d)?;
     let cos_1 = -d.dot(n_1);
     if !(cos_1 > 0.0) {
@@ -175,7 +190,7 @@ pub fn glint_map(chain: Chain, p1: &Patch, p2: Option<&Patch>, c: DVec3, d: DVec
     match chain {
         Chain::Reflect => {
             let o = d + n_1 * (2.0 * cos_1);
-            Some(GlintMap { d, x_1, n_1, cos_1, d_1: o, out: None, o })
+            Some(GlintMap { d, x_1, n_1, cos_1, d_1: o, refl: None, out: None, o })
         }
         Chain::Through => {
             let d_1 = refract_in(d, n_1, cos_1, p1.eta)?;
@@ -183,7 +198,22 @@ pub fn glint_map(chain: Chain, p1: &Patch, p2: Option<&Patch>, c: DVec3, d: DVec
             let nudge = 1e-7 * (1.0 + x_1.abs().max_element());
             let mut out = p2?.refract(x_1 + d_1 * nudge, d_1)?;
             out.t += nudge;
-            Some(GlintMap { d, x_1, n_1, cos_1, d_1, out: Some(out), o: out.o })
+            Some(GlintMap { d, x_1, n_1, cos_1, d_1, refl: None, out: Some(out), o: out.o })
+        }
+        Chain::Inside => {
+            let d_1 = refract_in(d, n_1, cos_1, p1.eta)?;
+            let nudge = 1e-7 * (1.0 + x_1.abs().max_element());
+            let (t_12, x_2, n_2) = p2?.hit(x_1 + d_1 * nudge, d_1)?;
+            let cos_2 = d_1.dot(n_2);
+            if !(t_12 > 0.0) || !(cos_2 > 0.0) {
+                return None;
+            }
+            let d_2 = d_1 - n_2 * (2.0 * cos_2);
+            let nudge_2 = 1e-7 * (1.0 + x_2.abs().max_element());
+            let mut out = p3?.refract(x_2 + d_2 * nudge_2, d_2)?;
+            out.t += nudge_2;
+            let refl = Some((x_2, n_2, t_12 + nudge, cos_2));
+            Some(GlintMap { d, x_1, n_1, cos_1, d_1, refl, out: Some(out), o: out.o })
         }
     }
 }
@@ -218,23 +248,36 @@ pub fn locate_at(
     cam: &CameraMap,
     chain: Chain,
     u: DVec2,
-) -> Option<(Patch, Option<Patch>, GlintMap)> {
+) -> Option<(Patch, Option<Patch>, Option<Patch>, GlintMap)> {
     let d = cam.direction(u);
     let (p1, n_geo) = locate.first(cam.origin, d)?;
-    let p2 = match chain {
-        Chain::Reflect => None,
-        Chain::Through => {
+    let (p2, p3) = match chain {
+        Chain::Reflect => (None, None),
+        Chain::Through | Chain::Inside => {
             let (_, x_1, n_1) = p1.hit(cam.origin, d)?;
             let cos_1 = -d.dot(n_1);
             if !(cos_1 > 0.0) {
                 return None;
             }
             let d_1 = refract_in(d, n_1, cos_1, p1.eta)?;
-            Some(locate.second(x_1, n_geo, d_1)?)
+            let p2 = locate.second(x_1, n_geo, d_1)?;
+            let p3 = if chain == Chain::Inside {
+                let nudge = 1e-7 * (1.0 + x_1.abs().max_element());
+                let (_, x_2, n_2) = p2.hit(x_1 + d_1 * nudge, d_1)?;
+                let cos_2 = d_1.dot(n_2);
+                if !(cos_2 > 0.0) {
+                    return None;
+                }
+                // The offset side from the shading normal (the reflected ray goes inwards).
+                Some(locate.second(x_2, n_2, d_1 - n_2 * (2.0 * cos_2))?)
+            } else {
+                None
+            };
+            (Some(p2), p3)
         }
     };
-    let m = glint_map(chain, &p1, p2.as_ref(), cam.origin, d)?;
-    Some((p1, p2, m))
+    let m = glint_map(chain, &p1, p2.as_ref(), p3.as_ref(), cam.origin, d)?;
+    Some((p1, p2, p3, m))
 }
 
 #[inline]
@@ -250,13 +293,14 @@ fn jacobian(
     chain: Chain,
     p1: &Patch,
     p2: Option<&Patch>,
+    p3: Option<&Patch>,
     u: DVec2,
     omega_l: DVec3,
     l: (DVec3, DVec3),
 ) -> Option<[[f64; 2]; 2]> {
     central_jacobian(FD_STEP, |a, b| {
         let moved = u + DVec2::new(a, b);
-        Some(residual(&glint_map(chain, p1, p2, cam.origin, cam.direction(moved))?, l, omega_l))
+        Some(residual(&glint_map(chain, p1, p2, p3, cam.origin, cam.direction(moved))?, l, omega_l))
     })
 }
 
@@ -269,6 +313,7 @@ pub struct GlintSolution {
     pub map: GlintMap,
     pub p1: Patch,
     pub p2: Option<Patch>,
+    pub p3: Option<Patch>,
     /// `|det do/du|⁻¹`: pixels² per steradian of outgoing directions.
     pub du_do: f64,
     pub iterations: u32,
@@ -287,16 +332,16 @@ pub fn solve(
 ) -> (Option<GlintSolution>, u32) {
     let l = tangents(omega_l);
     let mut u = seed;
-    let Some((mut p1, mut p2, mut m)) = locate_at(locate, cam, chain, u) else { return (None, 0) };
+    let Some((mut p1, mut p2, mut p3, mut m)) = locate_at(locate, cam, chain, u) else { return (None, 0) };
     for it in 0..=MAX_ITERATIONS {
         let norm = (m.o - omega_l).length();
-        let Some(j) = jacobian(cam, chain, &p1, p2.as_ref(), u, omega_l, l) else { return (None, it) };
+        let Some(j) = jacobian(cam, chain, &p1, p2.as_ref(), p3.as_ref(), u, omega_l, l) else { return (None, it) };
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
         if norm < TOLERANCE {
             if !(det.abs() > 0.0 && det.is_finite() && region.contains(u)) {
                 return (None, it);
             }
-            let s = GlintSolution { chain, u, map: m, p1, p2, du_do: 1.0 / det.abs(), iterations: it };
+            let s = GlintSolution { chain, u, map: m, p1, p2, p3, du_do: 1.0 / det.abs(), iterations: it };
             return (Some(s), it);
         }
         if it == MAX_ITERATIONS || !(det.abs() > 1e-300) {
@@ -311,7 +356,7 @@ pub fn solve(
         let mut scale = 1.0;
         for _ in 0..10 {
             let cand = u + step * scale;
-            if let Some(found) = locate_at(locate, cam, chain, cand).filter(|f| (f.2.o - omega_l).length() < norm) {
+            if let Some(found) = locate_at(locate, cam, chain, cand).filter(|f| (f.3.o - omega_l).length() < norm) {
                 accepted = Some((cand, found));
                 break;
             }
@@ -319,7 +364,7 @@ pub fn solve(
         }
         let Some((cand, found)) = accepted else { return (None, it + 1) };
         u = cand;
-        (p1, p2, m) = found;
+        (p1, p2, p3, m) = found;
     }
     (None, MAX_ITERATIONS)
 }
@@ -373,6 +418,14 @@ pub fn geometric_weight(s: &GlintSolution) -> f64 {
         (Chain::Through, Some(out), Some(p2)) => {
             let f_2 = fresnel(out.cos_out as f32, p2.eta as f32).0 as f64;
             (1.0 - f_1) * (1.0 - f_2) * (p2.eta * p2.eta) / (eta_1 * eta_1)
+        }
+        (Chain::Inside, Some(out), Some(p2)) => {
+            // The reflection from inside at x_2 (total when beyond the critical angle).
+            let cos_2 = s.map.refl.map_or(0.0, |r| r.3);
+            let f_2 = fresnel(-cos_2 as f32, p2.eta as f32).0 as f64;
+            let eta_3 = s.p3.map_or(p2.eta, |p| p.eta);
+            let f_3 = fresnel(out.cos_out as f32, eta_3 as f32).0 as f64;
+            (1.0 - f_1) * f_2 * (1.0 - f_3) * (eta_3 * eta_3) / (eta_1 * eta_1)
         }
         _ => 0.0,
     };
@@ -451,31 +504,61 @@ pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3,
             }
             (si_2, scene.media[medium as usize].transmittance(out.t as f32))
         }
-        (Chain::Through, None) => return Spectrum::ZERO,
+        (Chain::Inside, Some(out)) => {
+            let Some((x_2, n_2, t_12, _)) = s.map.refl else { return Spectrum::ZERO };
+            let d_1 = s.map.d_1.as_vec3().normalize();
+            if !(d_1.dot(si_1.n) < 0.0) {
+                return Spectrum::ZERO;
+            }
+            stats.rays += 1;
+            let Some(si_2) = scene.ray_intersect(&Ray::new(offset_origin(si_1.p, si_1.n, d_1), d_1)) else {
+                return Spectrum::ZERO;
+            };
+            let d_2 = (s.map.d_1 - n_2 * (2.0 * s.map.d_1.dot(n_2))).as_vec3().normalize();
+            let ok = super::locate::boundary_patch(scene, &si_2, medium, d_1).is_some()
+                && d_2.dot(si_2.n) < 0.0
+                && agrees(&si_2, x_2, n_2, t_12);
+            if !ok {
+                return Spectrum::ZERO;
+            }
+            stats.rays += 1;
+            let Some(si_3) = scene.ray_intersect(&Ray::new(offset_origin(si_2.p, si_2.n, d_2), d_2)) else {
+                return Spectrum::ZERO;
+            };
+            let ok = super::locate::boundary_patch(scene, &si_3, medium, d_2).is_some()
+                && si_3.n.dot(omega_l) > 0.0
+                && agrees(&si_3, out.x_k, out.n_s, out.t);
+            if !ok {
+                return Spectrum::ZERO;
+            }
+            (si_3, scene.media[medium as usize].transmittance((t_12 + out.t) as f32))
+        }
+        (Chain::Through | Chain::Inside, None) => return Spectrum::ZERO,
     };
     let tr_out = super::light_segment(scene, &last, omega_l, stats);
     tr_medium * tr_out * geometric_weight(s) as f32
 }
 
-/// Do glints run in this render, and which chains (`Reflect` needs a path of depth 2, `Through`
+/// Do glints run in this render, and which chains (`Reflect` needs a path of depth 2, `Inside`
+/// of depth 4 and `inner_glints`, `Through`
 /// of depth 3)?
-pub fn chains(scene: &Scene, snee: &Snee) -> (bool, bool) {
-    let Integrator::VolpathSnee(desc, _) = &scene.integrator else { return (false, false) };
+pub fn chains(scene: &Scene, snee: &Snee) -> (bool, bool, bool) {
+    let Integrator::VolpathSnee(desc, _) = &scene.integrator else { return (false, false, false) };
     let on = super::enabled(scene)
         && snee.options.keeps_all()
         && matches!(scene.camera, Camera::Perspective(_))
         && matches!(scene.film.filter, RFilter::Box)
         && scene.sensor_medium.is_none();
     let depth = |d: i32| desc.max_depth < 0 || desc.max_depth >= d;
-    (on && depth(2), on && depth(3))
+    (on && depth(2), on && depth(3), on && snee.options.inner_glints && depth(4))
 }
 
 /// The glints gathered by one camera sample (`ray`, from a pixel of a box-filtered film): for
 /// every directional emitter and chain, the SMS estimate of the glints inside the sample's pixel.
 /// Draws no random numbers when glints do not run.
 pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, ray: &Ray, stats: &mut LocalStats) -> Spectrum {
-    let (reflect, through) = chains(scene, snee);
-    if !(reflect || through) {
+    let (reflect, through, inside) = chains(scene, snee);
+    if !(reflect || through || inside) {
         return Spectrum::ZERO;
     }
     let Camera::Perspective(p) = &scene.camera else { return Spectrum::ZERO };
@@ -488,8 +571,8 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, ray: &Ray, stat
     for e in &scene.emitters {
         let SceneEmitter::Other(Emitter::Directional(e)) = e else { continue };
         let omega_l = -e.d.as_dvec3().normalize();
-        for chain in [Chain::Reflect, Chain::Through] {
-            if (chain == Chain::Reflect && !reflect) || (chain == Chain::Through && !through) {
+        for (chain, on) in [(Chain::Reflect, reflect), (Chain::Through, through), (Chain::Inside, inside)] {
+            if !on {
                 continue;
             }
             let mut locate = SceneGlint { scene, rays: 0 };
@@ -565,6 +648,24 @@ pub(super) mod tests {
     /// 10° of the view direction (glints through it). None near the silhouette's reflections
     /// (a light within θ of a reflection that grazes the rim without reaching it makes the cone
     /// limit at finite θ differ from its limit).
+    /// Directions to the light for glints through one internal reflection (`Inside`): on the
+    /// camera's side within 42° of the view axis (the primary rainbow's deviation is at least
+    /// 138°), away from that caustic.
+    fn inside_lights() -> [DVec3; 2] {
+        [DVec3::new(0.3, 0.25, 0.92).normalize(), DVec3::new(-0.1, 0.35, 0.93).normalize()]
+    }
+
+    /// The (chain, light) pairs the tests check.
+    fn cases() -> Vec<(Chain, DVec3)> {
+        let mut v = Vec::new();
+        for omega_l in lights() {
+            v.push((Chain::Reflect, omega_l));
+            v.push((Chain::Through, omega_l));
+        }
+        v.extend(inside_lights().map(|l| (Chain::Inside, l)));
+        v
+    }
+
     fn lights() -> [DVec3; 5] {
         [
             DVec3::new(0.3, 0.8, 0.5).normalize(),
@@ -609,17 +710,26 @@ pub(super) mod tests {
         let mut checked = 0;
         for eta in [1.5, 1.33] {
             let mut ball = Ball { eta };
-            for omega_l in lights() {
-                for chain in [Chain::Reflect, Chain::Through] {
+            for (chain, omega_l) in cases() {
+                {
                     for s in all_solutions(&mut ball, &cam, chain, omega_l) {
                         let m = &s.map;
                         assert!((m.o - omega_l).length() < 1e-8);
-                        match m.out {
-                            None => {
+                        match (m.out, m.refl) {
+                            (_, Some((x_2, n_2, _, cos_2))) => {
+                                // The law of reflection at x_2 and Snell's law at both refractions.
+                                let out = m.out.expect("refraction out");
+                                let d_2 = (out.x_k - x_2).normalize();
+                                assert!((d_2 - (m.d_1 - n_2 * (2.0 * cos_2))).length() < 1e-9);
+                                let sin_in = (1.0 - out.cos_in * out.cos_in).sqrt();
+                                let sin_out = (1.0 - out.cos_out * out.cos_out).sqrt();
+                                assert!((eta * sin_in - sin_out).abs() < 1e-7);
+                            }
+                            (None, _) => {
                                 assert!((m.o.dot(m.n_1) - m.cos_1).abs() < 1e-9);
                                 assert!(m.n_1.cross(m.d).dot(m.o).abs() < 1e-9);
                             }
-                            Some(out) => {
+                            (Some(out), None) => {
                                 let sin_in = (1.0 - out.cos_in * out.cos_in).sqrt();
                                 let sin_out = (1.0 - out.cos_out * out.cos_out).sqrt();
                                 assert!((eta * sin_in - sin_out).abs() < 1e-7);
@@ -663,15 +773,17 @@ pub(super) mod tests {
         let mut ball = Ball { eta: 1.5 };
         let p = ball.patch();
         let mut checked = 0;
-        for omega_l in lights() {
-            for chain in [Chain::Reflect, Chain::Through] {
+        for (chain, omega_l) in cases() {
+            {
                 // The integrand vanishes outside the cone: film positions uniform over the box of
                 // a 1/8-pixel grid's points within 3θ of omega_l, grown by one pixel.
                 let (mut lo, mut hi) = (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN));
                 for y in 0..64 * 8 {
                     for x in 0..48 * 8 {
                         let u = DVec2::new(x as f64 + 0.5, y as f64 + 0.5) / 8.0;
-                        let Some(g) = glint_map(chain, &p, Some(&p), cam.origin, cam.direction(u)) else { continue };
+                        let Some(g) = glint_map(chain, &p, Some(&p), Some(&p), cam.origin, cam.direction(u)) else {
+                            continue;
+                        };
                         if g.o.dot(omega_l) >= (3.0 * theta).cos() {
                             (lo, hi) = (lo.min(u), hi.max(u));
                         }
@@ -687,11 +799,14 @@ pub(super) mod tests {
                 for _ in 0..m {
                     let v = rng.next_2d();
                     let u = lo + (hi - lo) * DVec2::new(v.x as f64, v.y as f64);
-                    let Some(g) = glint_map(chain, &p, Some(&p), cam.origin, cam.direction(u)) else { continue };
+                    let Some(g) = glint_map(chain, &p, Some(&p), Some(&p), cam.origin, cam.direction(u)) else {
+                        continue;
+                    };
                     if g.o.dot(omega_l) < theta.cos() {
                         continue;
                     }
-                    let s = GlintSolution { chain, u, map: g, p1: p, p2: Some(p), du_do: 1.0, iterations: 0 };
+                    let s =
+                        GlintSolution { chain, u, map: g, p1: p, p2: Some(p), p3: Some(p), du_do: 1.0, iterations: 0 };
                     let w = geometric_weight(&s) * area / cone;
                     sum += w;
                     sq += w * w;
@@ -731,6 +846,6 @@ pub(super) mod tests {
                 assert!(z.abs() < 4.0, "{chain:?}: gathered {image} ± {se} vs cone limit {cone_mean} ± {cone_se}");
             }
         }
-        assert!(checked >= 5, "only {checked} glints checked");
+        assert!(checked >= 7, "only {checked} glints checked");
     }
 }

@@ -42,6 +42,9 @@ pub struct SneeOptions {
     /// `camera_reflections` ∈ {0, 1, 2}: internal reflections of the camera ray before `x_b`
     /// that camera beams connect through (`manifold/camera_beam.rs`).
     pub camera_reflections: u32,
+    /// `inner_glints` (with `connection = complete`): the camera's glints also through one
+    /// internal reflection (`manifold/glint.rs`, `Chain::Inside`).
+    pub inner_glints: bool,
 }
 
 impl Default for SneeOptions {
@@ -56,6 +59,7 @@ impl Default for SneeOptions {
             beams: true,
             camera_beams: false,
             camera_reflections: 0,
+            inner_glints: false,
         }
     }
 }
