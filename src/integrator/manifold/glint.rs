@@ -469,6 +469,22 @@ pub(super) fn agrees(si: &SurfaceInteraction, x: DVec3, n_s: DVec3, t: f64) -> b
     (si.p.as_dvec3() - x).length() <= 1e-3 * (1.0 + t) && si.sh_frame.n.as_dvec3().dot(n_s) > 1.0 - 1e-4
 }
 
+/// The chain's next interface from `si` along `d` inside `medium`: the renderer's own hit, when it
+/// is the medium's boundary met from inside and agrees with the solved point, shading normal and
+/// distance `(x, n, t)`.
+fn next_inside(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    d: crate::math::Vec3,
+    medium: u32,
+    (x, n, t): (DVec3, DVec3, f64),
+    stats: &mut LocalStats,
+) -> Option<SurfaceInteraction> {
+    stats.rays += 1;
+    let hit = scene.ray_intersect(&Ray::new(offset_origin(si.p, si.n, d), d))?;
+    (super::locate::boundary_patch(scene, &hit, medium, d).is_some() && agrees(&hit, x, n, t)).then_some(hit)
+}
+
 /// Verify a solution with the renderer's rays and return its value without `N`: the geometric
 /// weight times the medium's transmittance and the light segment's.
 pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3, stats: &mut LocalStats) -> Spectrum {
@@ -492,14 +508,10 @@ pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3,
             if !(d_1.dot(si_1.n) < 0.0) {
                 return Spectrum::ZERO;
             }
-            stats.rays += 1;
-            let Some(si_2) = scene.ray_intersect(&Ray::new(offset_origin(si_1.p, si_1.n, d_1), d_1)) else {
+            let Some(si_2) = next_inside(scene, &si_1, d_1, medium, (out.x_k, out.n_s, out.t), stats) else {
                 return Spectrum::ZERO;
             };
-            let ok = super::locate::boundary_patch(scene, &si_2, medium, d_1).is_some()
-                && si_2.n.dot(omega_l) > 0.0
-                && agrees(&si_2, out.x_k, out.n_s, out.t);
-            if !ok {
+            if !(si_2.n.dot(omega_l) > 0.0) {
                 return Spectrum::ZERO;
             }
             (si_2, scene.media[medium as usize].transmittance(out.t as f32))
@@ -510,25 +522,17 @@ pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3,
             if !(d_1.dot(si_1.n) < 0.0) {
                 return Spectrum::ZERO;
             }
-            stats.rays += 1;
-            let Some(si_2) = scene.ray_intersect(&Ray::new(offset_origin(si_1.p, si_1.n, d_1), d_1)) else {
+            let Some(si_2) = next_inside(scene, &si_1, d_1, medium, (x_2, n_2, t_12), stats) else {
                 return Spectrum::ZERO;
             };
             let d_2 = (s.map.d_1 - n_2 * (2.0 * s.map.d_1.dot(n_2))).as_vec3().normalize();
-            let ok = super::locate::boundary_patch(scene, &si_2, medium, d_1).is_some()
-                && d_2.dot(si_2.n) < 0.0
-                && agrees(&si_2, x_2, n_2, t_12);
-            if !ok {
+            if !(d_2.dot(si_2.n) < 0.0) {
                 return Spectrum::ZERO;
             }
-            stats.rays += 1;
-            let Some(si_3) = scene.ray_intersect(&Ray::new(offset_origin(si_2.p, si_2.n, d_2), d_2)) else {
+            let Some(si_3) = next_inside(scene, &si_2, d_2, medium, (out.x_k, out.n_s, out.t), stats) else {
                 return Spectrum::ZERO;
             };
-            let ok = super::locate::boundary_patch(scene, &si_3, medium, d_2).is_some()
-                && si_3.n.dot(omega_l) > 0.0
-                && agrees(&si_3, out.x_k, out.n_s, out.t);
-            if !ok {
+            if !(si_3.n.dot(omega_l) > 0.0) {
                 return Spectrum::ZERO;
             }
             (si_3, scene.media[medium as usize].transmittance((t_12 + out.t) as f32))
@@ -539,9 +543,8 @@ pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3,
     tr_medium * tr_out * geometric_weight(s) as f32
 }
 
-/// Do glints run in this render, and which chains (`Reflect` needs a path of depth 2, `Inside`
-/// of depth 4 and `inner_glints`, `Through`
-/// of depth 3)?
+/// Do glints run in this render, and which chains (`Reflect` needs a path of depth 2, `Through`
+/// of depth 3, `Inside` of depth 4 and `inner_glints`)?
 pub fn chains(scene: &Scene, snee: &Snee) -> (bool, bool, bool) {
     let Integrator::VolpathSnee(desc, _) = &scene.integrator else { return (false, false, false) };
     let on = super::enabled(scene)
