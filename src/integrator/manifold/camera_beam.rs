@@ -52,7 +52,7 @@
 //! boundary (a null surface in front of it is not handled).
 
 use super::beam::{self, Beam};
-use super::glint::{agrees, outer_patch, refract_in, CameraMap};
+use super::glint::{camera_hit, damped, mirror, newton_step, next_inside, nudge, outer_patch, refract_in, CameraMap};
 use super::locate::SceneLocate;
 use super::newton::{central_jacobian, tangents, Patch};
 use super::newton_point;
@@ -114,13 +114,6 @@ pub struct ChainMap {
     pub len: f64,
 }
 
-/// A small step along `dir` from a point on the boundary (selects the far root on a sphere; the
-/// line is unchanged).
-#[inline]
-fn nudge(x: DVec3) -> f64 {
-    1e-7 * (1.0 + x.abs().max_element())
-}
-
 /// The map of `chain` at `u`, or `None` when an interface is missed or met from the wrong side.
 pub fn chain_map(chain: &Chain, cam: &CameraMap, u: DVec2) -> Option<ChainMap> {
     let d = cam.direction(u);
@@ -142,7 +135,7 @@ pub fn chain_map(chain: &Chain, cam: &CameraMap, u: DVec2) -> Option<ChainMap> {
             return None;
         }
         m.len += t + e;
-        dir -= n * (2.0 * c);
+        dir = mirror(dir, n, c);
         at = x;
         m.x[i + 1] = x;
         m.n[i + 1] = n;
@@ -231,20 +224,11 @@ pub fn solve(
         if it == MAX_ITERATIONS || !(det.abs() > 1e-300) {
             return (None, it);
         }
-        let step = -DVec2::new(j[1][1] * r[0] - j[0][1] * r[1], -j[1][0] * r[0] + j[0][0] * r[1]) / det;
-        let mut accepted = None;
-        let mut scale = 1.0;
-        for _ in 0..10 {
-            let cand = u + step * scale;
-            if let Some(c) = relocate(cand) {
-                let better = residual(&c, cam, cand, x_b, l, lt).map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt() < norm);
-                if better == Some(true) {
-                    accepted = Some((cand, c));
-                    break;
-                }
-            }
-            scale *= 0.5;
-        }
+        let accepted = damped(u, newton_step(j, r, det), |cand| {
+            let c = relocate(cand)?;
+            let better = residual(&c, cam, cand, x_b, l, lt).map(|v| (v[0] * v[0] + v[1] * v[1]).sqrt() < norm);
+            (better == Some(true)).then_some(c)
+        });
         let Some((cand, c)) = accepted else { return (None, it + 1) };
         u = cand;
         chain = c;
@@ -297,10 +281,8 @@ fn verify(
 ) -> Option<(Spectrum, Vec3)> {
     let m = &s.map;
     let mut d = m.d.as_vec3().normalize();
-    stats.rays += 1;
-    let mut si = scene.ray_intersect(&Ray::new(cam.origin.as_vec3(), d))?;
-    let (_, hit_medium) = outer_patch(scene, &si, d)?;
-    if hit_medium != medium || !agrees(&si, m.x[0], m.n[0], (m.x[0] - cam.origin).length()) {
+    let (mut si, hit_medium) = camera_hit(scene, cam, d, m.x[0], m.n[0], stats)?;
+    if hit_medium != medium {
         return None;
     }
     let mut weight = Spectrum::ONE;
@@ -313,13 +295,7 @@ fn verify(
         weight *= w;
         d = wo;
         if i < s.chain.j {
-            stats.rays += 1;
-            let next = scene.ray_intersect(&Ray::new(offset_origin(si.p, si.n, d), d))?;
-            let on = super::locate::boundary_patch(scene, &next, medium, d).is_some();
-            if !on || !agrees(&next, m.x[i + 1], m.n[i + 1], m.len) {
-                return None;
-            }
-            si = next;
+            si = next_inside(scene, &si, d, medium, (m.x[i + 1], m.n[i + 1], m.len), stats)?;
         }
     }
     // The last segment inside the medium: its first hit lies beyond x_b.

@@ -171,6 +171,39 @@ pub(super) fn refract_in(d: DVec3, n: DVec3, cos_1: f64, eta: f64) -> Option<DVe
     Some((d / eta + n * (cos_1 / eta - cos_t2.sqrt())).normalize())
 }
 
+/// A small step along a ray leaving the boundary point `x` (selects the far root on a sphere; the
+/// line is unchanged).
+#[inline]
+pub(super) fn nudge(x: DVec3) -> f64 {
+    1e-7 * (1.0 + x.abs().max_element())
+}
+
+/// `d` reflected about the unit normal `n`, `cos = d · n` (the direction Mitsuba's `dielectric`
+/// reflects into).
+#[inline]
+pub(super) fn mirror(d: DVec3, n: DVec3, cos: f64) -> DVec3 {
+    d - n * (2.0 * cos)
+}
+
+/// The Newton step `−J⁻¹ r` of the 2×2 system `j` (determinant `det`) on the film.
+#[inline]
+pub(super) fn newton_step(j: [[f64; 2]; 2], r: [f64; 2], det: f64) -> DVec2 {
+    -DVec2::new(j[1][1] * r[0] - j[0][1] * r[1], -j[1][0] * r[0] + j[0][0] * r[1]) / det
+}
+
+/// The damped step from `u`: `step` halved (at most 10 times) until `accept` takes the point.
+pub(super) fn damped<T>(u: DVec2, step: DVec2, mut accept: impl FnMut(DVec2) -> Option<T>) -> Option<(DVec2, T)> {
+    let mut scale = 1.0;
+    for _ in 0..10 {
+        let cand = u + step * scale;
+        if let Some(v) = accept(cand) {
+            return Some((cand, v));
+        }
+        scale *= 0.5;
+    }
+    None
+}
+
 /// The chain through `p1` (and `p2` for `Through`, `p2` then `p3` for `Inside`) along the camera
 /// direction `d`, or `None` when `d` meets `p1` from inside, or a refraction is total, or a later
 /// patch is met from outside.
@@ -194,25 +227,25 @@ pub fn glint_map(
         }
         Chain::Through => {
             let d_1 = refract_in(d, n_1, cos_1, p1.eta)?;
-            // Start just past x_1 (selects the far root on a sphere; the line is unchanged).
-            let nudge = 1e-7 * (1.0 + x_1.abs().max_element());
-            let mut out = p2?.refract(x_1 + d_1 * nudge, d_1)?;
-            out.t += nudge;
+            // Start just past x_1.
+            let e = nudge(x_1);
+            let mut out = p2?.refract(x_1 + d_1 * e, d_1)?;
+            out.t += e;
             Some(GlintMap { d, x_1, n_1, cos_1, d_1, refl: None, out: Some(out), o: out.o })
         }
         Chain::Inside => {
             let d_1 = refract_in(d, n_1, cos_1, p1.eta)?;
-            let nudge = 1e-7 * (1.0 + x_1.abs().max_element());
-            let (t_12, x_2, n_2) = p2?.hit(x_1 + d_1 * nudge, d_1)?;
+            let e = nudge(x_1);
+            let (t_12, x_2, n_2) = p2?.hit(x_1 + d_1 * e, d_1)?;
             let cos_2 = d_1.dot(n_2);
             if !(t_12 > 0.0) || !(cos_2 > 0.0) {
                 return None;
             }
-            let d_2 = d_1 - n_2 * (2.0 * cos_2);
-            let nudge_2 = 1e-7 * (1.0 + x_2.abs().max_element());
-            let mut out = p3?.refract(x_2 + d_2 * nudge_2, d_2)?;
-            out.t += nudge_2;
-            let refl = Some((x_2, n_2, t_12 + nudge, cos_2));
+            let d_2 = mirror(d_1, n_2, cos_2);
+            let e_2 = nudge(x_2);
+            let mut out = p3?.refract(x_2 + d_2 * e_2, d_2)?;
+            out.t += e_2;
+            let refl = Some((x_2, n_2, t_12 + e, cos_2));
             Some(GlintMap { d, x_1, n_1, cos_1, d_1, refl, out: Some(out), o: out.o })
         }
     }
@@ -262,14 +295,13 @@ pub fn locate_at(
             let d_1 = refract_in(d, n_1, cos_1, p1.eta)?;
             let p2 = locate.second(x_1, n_geo, d_1)?;
             let p3 = if chain == Chain::Inside {
-                let nudge = 1e-7 * (1.0 + x_1.abs().max_element());
-                let (_, x_2, n_2) = p2.hit(x_1 + d_1 * nudge, d_1)?;
+                let (_, x_2, n_2) = p2.hit(x_1 + d_1 * nudge(x_1), d_1)?;
                 let cos_2 = d_1.dot(n_2);
                 if !(cos_2 > 0.0) {
                     return None;
                 }
                 // The offset side from the shading normal (the reflected ray goes inwards).
-                Some(locate.second(x_2, n_2, d_1 - n_2 * (2.0 * cos_2))?)
+                Some(locate.second(x_2, n_2, mirror(d_1, n_2, cos_2))?)
             } else {
                 None
             };
@@ -347,21 +379,12 @@ pub fn solve(
         if it == MAX_ITERATIONS || !(det.abs() > 1e-300) {
             return (None, it);
         }
-        let r = residual(&m, l, omega_l);
-        let step = -DVec2::new(j[1][1] * r[0] - j[0][1] * r[1], -j[1][0] * r[0] + j[0][0] * r[1]) / det;
+        let step = newton_step(j, residual(&m, l, omega_l), det);
         if !region.near(u + step, MARGIN) {
             return (None, it + 1);
         }
-        let mut accepted = None;
-        let mut scale = 1.0;
-        for _ in 0..10 {
-            let cand = u + step * scale;
-            if let Some(found) = locate_at(locate, cam, chain, cand).filter(|f| (f.3.o - omega_l).length() < norm) {
-                accepted = Some((cand, found));
-                break;
-            }
-            scale *= 0.5;
-        }
+        let accepted =
+            damped(u, step, |cand| locate_at(locate, cam, chain, cand).filter(|f| (f.3.o - omega_l).length() < norm));
         let Some((cand, found)) = accepted else { return (None, it + 1) };
         u = cand;
         (p1, p2, p3, m) = found;
@@ -469,10 +492,27 @@ pub(super) fn agrees(si: &SurfaceInteraction, x: DVec3, n_s: DVec3, t: f64) -> b
     (si.p.as_dvec3() - x).length() <= 1e-3 * (1.0 + t) && si.sh_frame.n.as_dvec3().dot(n_s) > 1.0 - 1e-4
 }
 
+/// The camera ray along `d`: the renderer's own first hit and the medium inside it, when it is a
+/// medium's smooth dielectric boundary met from outside and agrees with the solved point `x_1` and
+/// shading normal `n_1`.
+pub(super) fn camera_hit(
+    scene: &Scene,
+    cam: &CameraMap,
+    d: crate::math::Vec3,
+    x_1: DVec3,
+    n_1: DVec3,
+    stats: &mut LocalStats,
+) -> Option<(SurfaceInteraction, u32)> {
+    stats.rays += 1;
+    let si = scene.ray_intersect(&Ray::new(cam.origin.as_vec3(), d))?;
+    let (_, medium) = outer_patch(scene, &si, d)?;
+    agrees(&si, x_1, n_1, (x_1 - cam.origin).length()).then_some((si, medium))
+}
+
 /// The chain's next interface from `si` along `d` inside `medium`: the renderer's own hit, when it
 /// is the medium's boundary met from inside and agrees with the solved point, shading normal and
 /// distance `(x, n, t)`.
-fn next_inside(
+pub(super) fn next_inside(
     scene: &Scene,
     si: &SurfaceInteraction,
     d: crate::math::Vec3,
@@ -490,12 +530,7 @@ fn next_inside(
 pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3, stats: &mut LocalStats) -> Spectrum {
     let d = s.map.d.as_vec3().normalize();
     let omega_l = omega_l.as_vec3();
-    stats.rays += 1;
-    let Some(si_1) = scene.ray_intersect(&Ray::new(cam.origin.as_vec3(), d)) else { return Spectrum::ZERO };
-    let t_1 = (s.map.x_1 - cam.origin).length();
-    let Some((_, medium)) = outer_patch(scene, &si_1, d).filter(|_| agrees(&si_1, s.map.x_1, s.map.n_1, t_1)) else {
-        return Spectrum::ZERO;
-    };
+    let Some((si_1, medium)) = camera_hit(scene, cam, d, s.map.x_1, s.map.n_1, stats) else { return Spectrum::ZERO };
     let (last, tr_medium) = match (s.chain, s.map.out) {
         (Chain::Reflect, _) => {
             if !(omega_l.dot(si_1.n) > 0.0) {
@@ -525,7 +560,7 @@ pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3,
             let Some(si_2) = next_inside(scene, &si_1, d_1, medium, (x_2, n_2, t_12), stats) else {
                 return Spectrum::ZERO;
             };
-            let d_2 = (s.map.d_1 - n_2 * (2.0 * s.map.d_1.dot(n_2))).as_vec3().normalize();
+            let d_2 = mirror(s.map.d_1, n_2, s.map.d_1.dot(n_2)).as_vec3().normalize();
             if !(d_2.dot(si_2.n) < 0.0) {
                 return Spectrum::ZERO;
             }
