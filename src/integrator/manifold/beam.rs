@@ -126,12 +126,19 @@ fn shading_factor(si: &SurfaceInteraction, w_in: Vec3, w_out: Vec3) -> f32 {
     }
 }
 
-/// The delta lobe `component` (0: reflection, 1: refraction) of the dielectric at `si` for light
-/// arriving along `d` in importance mode: the world direction and the flux weight (with the
-/// shading-normal factor), or `None` when that lobe does not exist or leaves on the wrong side.
-fn scatter(scene: &Scene, si: &SurfaceInteraction, d: Vec3, component: u32) -> Option<(Vec3, Spectrum)> {
+/// The delta lobe `component` (0: reflection, 1: refraction) of the dielectric at `si` for a ray
+/// arriving along `d`, sampled in `mode` (importance for light subpaths, radiance for camera
+/// paths): the world direction and the BSDF weight, or `None` when that lobe does not exist or
+/// leaves on the wrong side (of the geometric or of the shading normal).
+pub(super) fn delta_lobe(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    d: Vec3,
+    component: u32,
+    mode: TransportMode,
+) -> Option<(Vec3, Spectrum)> {
     let si = SurfaceInteraction { wi: si.to_local(-d), ..*si };
-    let ctx = BsdfContext { mode: TransportMode::Importance, type_mask: flags::ALL, component };
+    let ctx = BsdfContext { mode, type_mask: flags::ALL, component };
     let (bs, weight) = scene.bsdf(&si).sample(&ctx, &si, 0.5, crate::math::Vec2::splat(0.5))?;
     let wo = si.to_world(bs.wo);
     // Reflection stays on the side the light came from, refraction crosses: geometric and shading
@@ -142,7 +149,14 @@ fn scatter(scene: &Scene, si: &SurfaceInteraction, d: Vec3, component: u32) -> O
     if same_side != want_same || shading_same != want_same || !(bs.wo.z != 0.0) {
         return None;
     }
-    Some((wo, weight * shading_factor(&si, -d, wo)))
+    Some((wo, weight))
+}
+
+/// [`delta_lobe`] for light arriving along `d` (importance mode): the direction and the flux weight
+/// with the shading-normal factor.
+fn scatter(scene: &Scene, si: &SurfaceInteraction, d: Vec3, component: u32) -> Option<(Vec3, Spectrum)> {
+    let (wo, weight) = delta_lobe(scene, si, d, component, TransportMode::Importance)?;
+    Some((wo, weight * shading_factor(si, -d, wo)))
 }
 
 /// Trace one light subpath from a directional light into `medium` (bounding sphere `b`) and

@@ -56,12 +56,12 @@ use super::glint::{camera_hit, damped, mirror, newton_step, next_inside, nudge, 
 use super::locate::SceneLocate;
 use super::newton::{central_jacobian, tangents, Patch};
 use super::newton_point;
-use crate::bsdf::{flags, BsdfContext, TransportMode};
+use crate::bsdf::TransportMode;
 use crate::color::Spectrum;
 use crate::integrator::snee::Snee;
 use crate::integrator::splat::{self, Splat};
 use crate::integrator::stats::LocalStats;
-use crate::interaction::{offset_origin, SurfaceInteraction};
+use crate::interaction::offset_origin;
 use crate::math::{DVec3, Ray, Vec3};
 use crate::sampler::Sampler;
 use crate::scene::world::Scene;
@@ -252,20 +252,6 @@ fn beam_point(sigma_mean: f32, len: f32, v: f32) -> Option<(f32, f32)> {
     (pdf > 0.0 && pdf.is_finite()).then_some((t, 1.0 / pdf))
 }
 
-/// The dielectric's delta lobe `component` (0: reflection, 1: refraction) at `si` for the camera
-/// path arriving along `d` (radiance mode, as the camera path samples it): direction and weight.
-fn camera_lobe(scene: &Scene, si: &SurfaceInteraction, d: Vec3, component: u32) -> Option<(Vec3, Spectrum)> {
-    let local = SurfaceInteraction { wi: si.to_local(-d), ..*si };
-    let ctx = BsdfContext { mode: TransportMode::Radiance, type_mask: flags::ALL, component };
-    let (bs, weight) = scene.bsdf(&local).sample(&ctx, &local, 0.5, crate::math::Vec2::splat(0.5))?;
-    // The lobe leaves on the side it should, for the shading and the geometric normal.
-    let wo = local.to_world(bs.wo);
-    let reflect = component == 0;
-    let shading_ok = (bs.wo.z * local.wi.z > 0.0) == reflect;
-    let geometric_ok = (wo.dot(si.n) * (-d).dot(si.n) > 0.0) == reflect;
-    (shading_ok && geometric_ok && bs.wo.z != 0.0).then_some((wo, weight))
-}
-
 /// Verify a solution with the renderer's f32 rays (the camera ray's first hit is the boundary of
 /// `medium` at the solved point and normal, each reflection the first hit of the segment before
 /// it, the last segment reaches `x_b` unblocked) and return the camera-side factor
@@ -287,7 +273,8 @@ fn verify(
     }
     let mut weight = Spectrum::ONE;
     for i in 0..=s.chain.j {
-        let (wo, w) = camera_lobe(scene, &si, d, if i == 0 { 1 } else { 0 })?;
+        // The camera path's own lobe there (radiance mode): refraction in, then reflections.
+        let (wo, w) = beam::delta_lobe(scene, &si, d, if i == 0 { 1 } else { 0 }, TransportMode::Radiance)?;
         let want = if i == s.chain.j { m.dir } else { m.x[i + 1] - m.x[i] }.as_vec3().normalize();
         if !(wo.dot(want) > 1.0 - 1e-4) {
             return None;
