@@ -294,6 +294,31 @@ pub fn render_range(
             }
         };
 
+    // A sample's channels in `channels`' order: RGB, [alpha from `valid`], [its square],
+    // [per class: RGB, [its square]].
+    let pack = |values: &mut [f32], l: Spectrum, valid: bool, split: &ClassValues| {
+        values[..3].copy_from_slice(&l.to_array());
+        let mut k = 3;
+        if rgba {
+            values[3] = if valid { 1.0 } else { 0.0 };
+            k = 4;
+        }
+        if moment {
+            values[k..k + 3].copy_from_slice(&(l * l).to_array());
+            k += 3;
+        }
+        if classes {
+            for v in split {
+                values[k..k + 3].copy_from_slice(&v.to_array());
+                k += 3;
+                if moment {
+                    values[k..k + 3].copy_from_slice(&(*v * *v).to_array());
+                    k += 3;
+                }
+            }
+        }
+    };
+
     // `path` on diffuse scenes renders several pixels at once (`integrator/path_wide.rs`).
     let wide = path_wide::applies(scene);
     // One tile's samples `next..pass_end` of every pixel (the chunk starting at `chunk` replayed
@@ -313,26 +338,7 @@ pub fn render_range(
         let mut split = [Spectrum::ZERO; N_CLASSES];
         // One sample into the block: its channels in `channels`' order.
         let mut put = |pos: Vec2, l: Spectrum, valid: bool, split: &ClassValues| {
-            values[..3].copy_from_slice(&l.to_array());
-            let mut k = 3;
-            if rgba {
-                values[3] = if valid { 1.0 } else { 0.0 };
-                k = 4;
-            }
-            if moment {
-                values[k..k + 3].copy_from_slice(&(l * l).to_array());
-                k += 3;
-            }
-            if classes {
-                for v in split {
-                    values[k..k + 3].copy_from_slice(&v.to_array());
-                    k += 3;
-                    if moment {
-                        values[k..k + 3].copy_from_slice(&(*v * *v).to_array());
-                        k += 3;
-                    }
-                }
-            }
+            pack(&mut values, l, valid, split);
             block.put(pos, &values);
         };
         // Unique per film pixel (the border may lie outside the film: offset it).
@@ -372,31 +378,17 @@ pub fn render_range(
         bar.inc(n);
         Some((block, splats, n))
     };
-    // A splat's channels in `channels`' order, scaled by `1 / pixels` (one light subpath per
-    // camera sample, `integrator::splat`): value, no alpha, its square as second moment, and the
-    // class `internal_reflection`.
+    // A splat's channels, scaled by `1 / pixels` (one light subpath per camera sample,
+    // `integrator::splat`): packed as a sample's, with no alpha, its square as second moment, and
+    // the class `internal_reflection`.
     let splat_scale = 1.0 / pixels as f32;
-    let splat_values = |v: Spectrum, out: &mut Vec<f32>| {
+    let splat_values = |v: Spectrum, out: &mut [f32]| {
         let v = v * splat_scale;
-        out.clear();
-        out.extend(v.to_array());
-        if rgba {
-            out.push(0.0);
-        }
-        if moment {
-            out.extend((v * v).to_array());
-        }
-        if classes {
-            for class in 0..N_CLASSES {
-                let c = if class == PathClass::InternalReflection as usize { v } else { Spectrum::ZERO };
-                out.extend(c.to_array());
-                if moment {
-                    out.extend((c * c).to_array());
-                }
-            }
-        }
+        let mut split = [Spectrum::ZERO; N_CLASSES];
+        split[PathClass::InternalReflection as usize] = v;
+        pack(out, v, false, &split);
     };
-    let mut splat_buf = Vec::with_capacity(nch);
+    let mut splat_buf = vec![0.0f32; nch];
 
     // Next sample index per pixel; the image holds samples start_sample..next.
     let mut next = start_sample;
