@@ -156,6 +156,9 @@ pub fn build(scene: &Scene, options: SneeOptions, connection: Connection) -> Sne
             snee.options.connection_rate = q_top.filter(|&q| q < manifold::curved_finite::RATE).map(|q| q as f32);
         }
         snee.meter_glint = meter_glint(scene);
+        if let Camera::Perspective(p) = &scene.camera {
+            snee.camera = Some(manifold::glint::CameraMap::new(p, scene.film.width, scene.film.height));
+        }
         snee.split = manifold::split::tables(scene, snee.options);
         if snee.options.beams && snee.options.keeps_all() && snee.has_directional {
             snee.beams = manifold::beam::beam_boundaries(scene);

@@ -304,6 +304,14 @@ const SEED_OFFSETS: [(f64, f64); 5] = [(0.0, 0.0), (4.0, 0.0), (-4.0, 0.0), (0.0
 /// Two solutions closer than this on the film (pixels) are the same.
 const SAME_SOLUTION: f64 = 1e-3;
 
+/// The point `x_b = o + t d` on `beam` ([`beam_point`]'s `t` and `1/p(t)`).
+#[derive(Clone, Copy, Debug)]
+struct BeamPoint {
+    x_b: Vec3,
+    t: f32,
+    inv_pdf: f32,
+}
+
 /// One point on `beam` connected to the camera through `j` internal reflections of the camera
 /// ray: a splat per distinct verified solution.
 /// `curved`: the boundary is curved (`Snee::curved`); on a flat one the straight-line seed alone
@@ -315,14 +323,12 @@ fn connect(
     medium: u32,
     curved: bool,
     beam: &Beam,
-    v: f32,
+    point: BeamPoint,
     j: usize,
     stats: &mut LocalStats,
 ) {
     let m = &scene.media[medium as usize];
-    let sigma_mean = m.sigma_t.to_array().iter().sum::<f32>() / 3.0;
-    let Some((t, inv_pdf)) = beam_point(sigma_mean, beam.len, v) else { return };
-    let x_b = beam.o + beam.d * t;
+    let BeamPoint { x_b, t, inv_pdf } = point;
     let Some(u0) = cam.film_position(x_b.as_dvec3() - cam.origin) else { return };
     let offsets = if curved { &SEED_OFFSETS[..] } else { &SEED_OFFSETS[..1] };
     let mut seeds: Vec<DVec2> = offsets.iter().map(|&(dx, dy)| u0 + DVec2::new(dx, dy)).collect();
@@ -373,14 +379,14 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, stats: &mut Loc
     if !snee.camera_beams {
         return;
     }
-    let Camera::Perspective(p) = &scene.camera else { return };
-    let cam = CameraMap::new(p, scene.film.width, scene.film.height);
+    let Some(cam) = &snee.camera else { return };
     let max_depth = u32::try_from(scene.integrator.max_depth).unwrap_or(u32::MAX);
     for (medium, b) in snee.beams.iter().enumerate() {
         let Some(b) = b else { continue };
         let set = beam::trace(scene, medium as u32, b, sampler, stats);
         let j_max = snee.options.camera_reflections as usize;
         let curved = snee.curved.get(medium).copied().unwrap_or(true);
+        let sigma_mean = scene.media[medium].sigma_t.to_array().iter().sum::<f32>() / 3.0;
         for beam in set.beams() {
             // Depth after the refraction out: x_c (1), j reflections, x_b (2 + j), k reflections,
             // the refraction out (3 + j + k).
@@ -389,9 +395,11 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, stats: &mut Loc
             }
             let v = sampler.next_1d();
             stats.camera_beam_points += 1;
+            let Some((t, inv_pdf)) = beam_point(sigma_mean, beam.len, v) else { continue };
+            let point = BeamPoint { x_b: beam.o + beam.d * t, t, inv_pdf };
             for j in 0..=j_max.min(MAX_CAMERA_REFLECTIONS) {
                 if 3 + j as u32 + beam.reflections < max_depth {
-                    connect(scene, &cam, medium as u32, curved, beam, v, j, stats);
+                    connect(scene, cam, medium as u32, curved, beam, point, j, stats);
                 }
             }
         }

@@ -85,7 +85,7 @@ pub enum Chain {
 
 /// The pinhole camera's map from film positions (pixels of the full film) to world directions,
 /// in f64 (the same map as `Perspective::sample_ray`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraMap {
     pub origin: DVec3,
     pub to_world: DMat4,
@@ -599,8 +599,7 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, ray: &Ray, stat
     if !(reflect || through || inside) {
         return Spectrum::ZERO;
     }
-    let Camera::Perspective(p) = &scene.camera else { return Spectrum::ZERO };
-    let cam = CameraMap::new(p, scene.film.width, scene.film.height);
+    let Some(cam) = &snee.camera else { return Spectrum::ZERO };
     let Some(pos) = cam.film_position(ray.d.as_dvec3()) else { return Spectrum::ZERO };
     let region = Region::pixel(pos.floor());
     // The sample's own position (rounding may put it a hair outside its pixel).
@@ -619,13 +618,13 @@ pub fn sample(scene: &Scene, snee: &Snee, sampler: &mut Sampler, ray: &Ray, stat
                 let v = sampler.next_2d();
                 (v.x as f64, v.y as f64)
             };
-            let found = sample_solution(&mut locate, &cam, chain, omega_l, region, seed, &mut u, &mut counts);
+            let found = sample_solution(&mut locate, cam, chain, omega_l, region, seed, &mut u, &mut counts);
             stats.rays += locate.rays;
             stats.glint_solves += counts.solves;
             stats.glint_iterations += counts.iterations;
             stats.glint_trials_capped += counts.capped;
             let Some((s, n)) = found else { continue };
-            let value = verify(scene, &cam, &s, omega_l, stats) * e.irradiance * n as f32;
+            let value = verify(scene, cam, &s, omega_l, stats) * e.irradiance * n as f32;
             if value != Spectrum::ZERO {
                 stats.glint_solutions += 1;
             }

@@ -109,6 +109,9 @@ pub struct Snee {
     /// With `connection = complete`: the irradiance meter's direction mixture towards the glints
     /// of directional lights on the rough boundary it faces (`manifold::meter_glint`).
     pub meter_glint: Option<crate::integrator::manifold::meter_glint::MeterGlint>,
+    /// With `connection = complete` and a `perspective` sensor: its map from film positions to
+    /// directions, for the camera's glints and camera beams (built once at load).
+    pub camera: Option<crate::integrator::manifold::glint::CameraMap>,
     /// With `connection = complete` and `split_glints`: what emitter splitting at smooth
     /// dielectric vertices needs of the scene (`manifold::split`); `None` where it does not run.
     pub split: Option<crate::integrator::manifold::split_bounds::SplitTables>,

@@ -23,6 +23,7 @@ pub fn build(scene: &Scene, options: SneeOptions) -> Snee {
         forward_only: false,
         has_directional: false,
         meter_glint: None,
+        camera: None,
         split: None,
         beams: Vec::new(),
         camera_beams: false,
