@@ -70,12 +70,12 @@ pub struct ManifoldStage<'a> {
     medium_predecessor: bool,
     /// The beams of this path's light subpath (`beam.rs`), traced at its first vertex that needs them.
     beams: Option<BeamSet>,
-    /// Surfaces the path has reached, and medium vertices it has had.
-    surfaces: u32,
-    scatters: u32,
+    /// Has the path had a medium vertex?
+    scattered: bool,
     /// Before the first medium vertex: is the path so far a camera prefix that camera beams
     /// connect (`camera_beam.rs`: a delta refraction into a medium's boundary, then delta
-    /// reflections on medium boundaries), and how many reflections has it had?
+    /// reflections on medium boundaries; every BSDF event, a null crossing too, passes
+    /// [`Self::after_bsdf`]), and how many reflections has it had?
     prefix_ok: bool,
     prefix_entered: bool,
     prefix_reflections: u32,
@@ -101,8 +101,7 @@ impl<'a> ManifoldStage<'a> {
             after_scatter: false,
             medium_predecessor: false,
             beams: None,
-            surfaces: 0,
-            scatters: 0,
+            scattered: false,
             prefix_ok: true,
             prefix_entered: false,
             prefix_reflections: 0,
@@ -116,14 +115,11 @@ impl<'a> ManifoldStage<'a> {
     pub fn at_scatter(&mut self, cx: &mut Cx, snee: &SneeStage, v: &Scatter) -> Spectrum {
         self.x_i = snee.chain_x_i().copied();
         self.medium_predecessor = std::mem::replace(&mut self.after_scatter, true);
-        // No null crossing (`depth` counts the non-null events, `surfaces` every hit).
-        self.camera_first = self.scatters == 0
+        self.camera_first = !self.scattered
             && self.prefix_ok
             && self.prefix_entered
-            && self.prefix_reflections <= self.snee.options.camera_reflections
-            && v.depth == self.surfaces + 1
-            && v.depth == 2 + self.prefix_reflections;
-        self.scatters += 1;
+            && self.prefix_reflections <= self.snee.options.camera_reflections;
+        self.scattered = true;
         self.tracker.sample(cx, self.snee.options, snee.chain_x_i(), v)
     }
 
@@ -191,7 +187,6 @@ impl<'a> ManifoldStage<'a> {
     #[inline]
     pub fn at_surface(&mut self, si: Option<&SurfaceInteraction>) {
         self.after_scatter = false;
-        self.surfaces += si.is_some() as u32;
         shift(&mut self.arrived, &mut self.tracker.pending);
         shift(&mut self.rough_arrived, &mut self.rough_pending);
         shift(&mut self.curved_arrived, &mut self.curved_pending);
@@ -237,7 +232,7 @@ impl<'a> ManifoldStage<'a> {
     /// (The pending records are empty here: [`Self::at_surface`] moved them to the arrived ones.)
     #[inline]
     pub fn after_bsdf(&mut self, scene: &Scene, s: &SurfaceInteraction, bs: &BsdfSample, wo: Vec3) {
-        if self.scatters == 0 && self.prefix_ok {
+        if !self.scattered && self.prefix_ok {
             self.track_prefix(scene, s, bs);
         }
         debug_assert!(self.rough_pending.is_none() && self.curved_pending.is_none() && self.tracker.pending.is_none());
