@@ -192,26 +192,37 @@ fn diagnose_camera_solves_on_the_statue() {
     );
 }
 
+/// The ball scene with camera beams on, written to `target/test-output/<name>/ball.xml`: the folder
+/// and the file.
+fn ball_file(name: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let dir = common::root().join("target/test-output").join(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("ball.xml");
+    std::fs::write(&scene, ball_scene(true)).unwrap();
+    (dir, scene)
+}
+
+/// Run the `snee` binary; it must succeed.
+fn snee(args: &[&str]) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_snee")).args(args).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 /// Splats land in tile order: the same seed gives the same image, bit for bit, at 1 and 2 threads
 /// (`snee render --threads`), and with `--classes --moment` too.
 #[test]
 fn camera_beam_splats_are_deterministic_across_thread_counts() {
-    let dir = common::root().join("target/test-output/camera_beams");
-    std::fs::create_dir_all(&dir).unwrap();
-    let scene = dir.join("ball.xml");
-    std::fs::write(&scene, ball_scene(true)).unwrap();
+    let (dir, scene) = ball_file("camera_beams");
     for extra in [&[][..], &["--classes", "--moment"][..]] {
         let mut images = Vec::new();
         for threads in ["1", "2"] {
             let exr = dir.join(format!("det{threads}.exr"));
             let stats = dir.join(format!("det{threads}.json"));
-            let o = std::process::Command::new(env!("CARGO_BIN_EXE_snee"))
-                .args(["render", scene.to_str().unwrap(), "-o", exr.to_str().unwrap(), "--spp", "8", "--seed", "4"])
-                .args(["-q", "--threads", threads, "--stats", stats.to_str().unwrap()])
-                .args(extra)
-                .output()
-                .unwrap();
-            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            let (scene, exr_s, stats_s) = (scene.to_str().unwrap(), exr.to_str().unwrap(), stats.to_str().unwrap());
+            let mut args = vec!["render", scene, "-o", exr_s, "--spp", "8", "--seed", "4"];
+            args.extend(["-q", "--threads", threads, "--stats", stats_s]);
+            args.extend(extra);
+            snee(&args);
             let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
             assert!(s["camera_beam_splats"].as_u64().unwrap() > 0, "{s}");
             images.push(snee::io::read::read_image(&exr, false).unwrap().data);
@@ -227,15 +238,8 @@ fn camera_beam_splats_are_deterministic_across_thread_counts() {
 /// sample 4, whose splats belong to the other range.)
 #[test]
 fn camera_beam_sample_ranges_merge_into_the_whole_render() {
-    let dir = common::root().join("target/test-output/camera_beams_merge");
-    std::fs::create_dir_all(&dir).unwrap();
-    let scene = dir.join("ball.xml");
-    std::fs::write(&scene, ball_scene(true)).unwrap();
+    let (dir, scene) = ball_file("camera_beams_merge");
     let path = |n: &str| dir.join(n).to_str().unwrap().to_string();
-    let snee = |args: &[&str]| {
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_snee")).args(args).output().unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    };
     let base = ["--spp", "9", "--seed", "5", "-q", "--classes", "--moment"];
     let render = |out: &str, extra: &[&str]| {
         let mut args = vec!["render", scene.to_str().unwrap(), "-o", out];
