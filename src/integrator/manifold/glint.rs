@@ -525,6 +525,36 @@ pub(super) fn next_inside(
     (super::locate::boundary_patch(scene, &hit, medium, d).is_some() && agrees(&hit, x, n, t)).then_some(hit)
 }
 
+/// The legs of `Through` and `Inside` inside the medium, with the renderer's rays: in along `d_1`
+/// from `si_1`, [the reflection at `x_2`], out at the last interface `out` (facing the light);
+/// the last hit and the medium's transmittance along the legs.
+fn inner_legs(
+    scene: &Scene,
+    s: &GlintSolution,
+    si_1: &SurfaceInteraction,
+    medium: u32,
+    out: &Refracted,
+    omega_l: crate::math::Vec3,
+    stats: &mut LocalStats,
+) -> Option<(SurfaceInteraction, Spectrum)> {
+    let mut d = s.map.d_1.as_vec3().normalize();
+    if !(d.dot(si_1.n) < 0.0) {
+        return None;
+    }
+    let (mut si, mut length) = (*si_1, out.t);
+    if let Some((x_2, n_2, t_12, _)) = s.map.refl {
+        si = next_inside(scene, &si, d, medium, (x_2, n_2, t_12), stats)?;
+        d = mirror(s.map.d_1, n_2, s.map.d_1.dot(n_2)).as_vec3().normalize();
+        if !(d.dot(si.n) < 0.0) {
+            return None;
+        }
+        length += t_12;
+    }
+    let last = next_inside(scene, &si, d, medium, (out.x_k, out.n_s, out.t), stats)?;
+    let tr = scene.media[medium as usize].transmittance(length as f32);
+    (last.n.dot(omega_l) > 0.0).then_some((last, tr))
+}
+
 /// Verify a solution with the renderer's rays and return its value without `N`: the geometric
 /// weight times the medium's transmittance and the light segment's.
 pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3, stats: &mut LocalStats) -> Spectrum {
@@ -538,39 +568,9 @@ pub fn verify(scene: &Scene, cam: &CameraMap, s: &GlintSolution, omega_l: DVec3,
             }
             (si_1, Spectrum::ONE)
         }
-        (Chain::Through, Some(out)) => {
-            let d_1 = s.map.d_1.as_vec3().normalize();
-            if !(d_1.dot(si_1.n) < 0.0) {
-                return Spectrum::ZERO;
-            }
-            let Some(si_2) = next_inside(scene, &si_1, d_1, medium, (out.x_k, out.n_s, out.t), stats) else {
-                return Spectrum::ZERO;
-            };
-            if !(si_2.n.dot(omega_l) > 0.0) {
-                return Spectrum::ZERO;
-            }
-            (si_2, scene.media[medium as usize].transmittance(out.t as f32))
-        }
-        (Chain::Inside, Some(out)) => {
-            let Some((x_2, n_2, t_12, _)) = s.map.refl else { return Spectrum::ZERO };
-            let d_1 = s.map.d_1.as_vec3().normalize();
-            if !(d_1.dot(si_1.n) < 0.0) {
-                return Spectrum::ZERO;
-            }
-            let Some(si_2) = next_inside(scene, &si_1, d_1, medium, (x_2, n_2, t_12), stats) else {
-                return Spectrum::ZERO;
-            };
-            let d_2 = mirror(s.map.d_1, n_2, s.map.d_1.dot(n_2)).as_vec3().normalize();
-            if !(d_2.dot(si_2.n) < 0.0) {
-                return Spectrum::ZERO;
-            }
-            let Some(si_3) = next_inside(scene, &si_2, d_2, medium, (out.x_k, out.n_s, out.t), stats) else {
-                return Spectrum::ZERO;
-            };
-            if !(si_3.n.dot(omega_l) > 0.0) {
-                return Spectrum::ZERO;
-            }
-            (si_3, scene.media[medium as usize].transmittance((t_12 + out.t) as f32))
+        (Chain::Through | Chain::Inside, Some(out)) => {
+            let Some(legs) = inner_legs(scene, s, &si_1, medium, &out, omega_l, stats) else { return Spectrum::ZERO };
+            legs
         }
         (Chain::Through | Chain::Inside, None) => return Spectrum::ZERO,
     };
