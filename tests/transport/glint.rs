@@ -28,7 +28,7 @@ fn statue_glints_are_found_and_finite() {
         for y in 0..h * 4 {
             for x in 0..w * 4 {
                 let u = DVec2::new(x as f64 + 0.5, y as f64 + 0.5) / 4.0;
-                let Some((_, _, _, m)) = glint::locate_at(&mut locate, &cam, chain, u) else { continue };
+                let Some((_, m)) = glint::locate_at(&mut locate, &cam, chain, u) else { continue };
                 on += 1;
                 let a = m.o.dot(omega_l).clamp(-1.0, 1.0).acos();
                 if a < best.0 {

@@ -204,17 +204,19 @@ pub(super) fn damped<T>(u: DVec2, step: DVec2, mut accept: impl FnMut(DVec2) -> 
     None
 }
 
-/// The chain through `p1` (and `p2` for `Through`, `p2` then `p3` for `Inside`) along the camera
-/// direction `d`, or `None` when `d` meets `p1` from inside, or a refraction is total, or a later
-/// patch is met from outside.
-pub fn glint_map(
-    chain: Chain,
-    p1: &Patch,
-    p2: Option<&Patch>,
-    p3: Option<&Patch>,
-    c: DVec3,
-    d: DVec3,
-) -> Option<GlintMap> {
+/// The located patches of a chain: `p1` where the camera ray meets the boundary, `p2` the next
+/// interface (`Through`, `Inside`), `p3` the one after it (`Inside`).
+#[derive(Clone, Copy, Debug)]
+pub struct Patches {
+    pub p1: Patch,
+    pub p2: Option<Patch>,
+    pub p3: Option<Patch>,
+}
+
+/// The chain through its patches along the camera direction `d`, or `None` when `d` meets `p1`
+/// from inside, or a refraction is total, or a later patch is met from outside.
+pub fn glint_map(chain: Chain, patches: &Patches, c: DVec3, d: DVec3) -> Option<GlintMap> {
+    let Patches { p1, p2, p3 } = *patches;
     let (_, x_1, n_1) = p1.hit(c, d)?;
     let cos_1 = -d.dot(n_1);
     if !(cos_1 > 0.0) {
@@ -281,7 +283,7 @@ pub fn locate_at(
     cam: &CameraMap,
     chain: Chain,
     u: DVec2,
-) -> Option<(Patch, Option<Patch>, Option<Patch>, GlintMap)> {
+) -> Option<(Patches, GlintMap)> {
     let d = cam.direction(u);
     let (p1, n_geo) = locate.first(cam.origin, d)?;
     let (p2, p3) = match chain {
@@ -308,8 +310,9 @@ pub fn locate_at(
             (Some(p2), p3)
         }
     };
-    let m = glint_map(chain, &p1, p2.as_ref(), p3.as_ref(), cam.origin, d)?;
-    Some((p1, p2, p3, m))
+    let patches = Patches { p1, p2, p3 };
+    let m = glint_map(chain, &patches, cam.origin, d)?;
+    Some((patches, m))
 }
 
 #[inline]
@@ -319,20 +322,17 @@ fn residual(m: &GlintMap, l: (DVec3, DVec3), omega_l: DVec3) -> [f64; 2] {
 }
 
 /// `dC/du` through fixed patches (columns: u.x, u.y), by central differences of the closed form.
-#[allow(clippy::too_many_arguments)]
 fn jacobian(
     cam: &CameraMap,
     chain: Chain,
-    p1: &Patch,
-    p2: Option<&Patch>,
-    p3: Option<&Patch>,
+    patches: &Patches,
     u: DVec2,
     omega_l: DVec3,
     l: (DVec3, DVec3),
 ) -> Option<[[f64; 2]; 2]> {
     central_jacobian(FD_STEP, |a, b| {
         let moved = u + DVec2::new(a, b);
-        Some(residual(&glint_map(chain, p1, p2, p3, cam.origin, cam.direction(moved))?, l, omega_l))
+        Some(residual(&glint_map(chain, patches, cam.origin, cam.direction(moved))?, l, omega_l))
     })
 }
 
@@ -343,9 +343,7 @@ pub struct GlintSolution {
     /// Film position (pixels).
     pub u: DVec2,
     pub map: GlintMap,
-    pub p1: Patch,
-    pub p2: Option<Patch>,
-    pub p3: Option<Patch>,
+    pub patches: Patches,
     /// `|det do/du|⁻¹`: pixels² per steradian of outgoing directions.
     pub du_do: f64,
     pub iterations: u32,
@@ -364,16 +362,16 @@ pub fn solve(
 ) -> (Option<GlintSolution>, u32) {
     let l = tangents(omega_l);
     let mut u = seed;
-    let Some((mut p1, mut p2, mut p3, mut m)) = locate_at(locate, cam, chain, u) else { return (None, 0) };
+    let Some((mut patches, mut m)) = locate_at(locate, cam, chain, u) else { return (None, 0) };
     for it in 0..=MAX_ITERATIONS {
         let norm = (m.o - omega_l).length();
-        let Some(j) = jacobian(cam, chain, &p1, p2.as_ref(), p3.as_ref(), u, omega_l, l) else { return (None, it) };
+        let Some(j) = jacobian(cam, chain, &patches, u, omega_l, l) else { return (None, it) };
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
         if norm < TOLERANCE {
             if !(det.abs() > 0.0 && det.is_finite() && region.contains(u)) {
                 return (None, it);
             }
-            let s = GlintSolution { chain, u, map: m, p1, p2, p3, du_do: 1.0 / det.abs(), iterations: it };
+            let s = GlintSolution { chain, u, map: m, patches, du_do: 1.0 / det.abs(), iterations: it };
             return (Some(s), it);
         }
         if it == MAX_ITERATIONS || !(det.abs() > 1e-300) {
@@ -384,10 +382,10 @@ pub fn solve(
             return (None, it + 1);
         }
         let accepted =
-            damped(u, step, |cand| locate_at(locate, cam, chain, cand).filter(|f| (f.3.o - omega_l).length() < norm));
+            damped(u, step, |cand| locate_at(locate, cam, chain, cand).filter(|f| (f.1.o - omega_l).length() < norm));
         let Some((cand, found)) = accepted else { return (None, it + 1) };
         u = cand;
-        (p1, p2, p3, m) = found;
+        (patches, m) = found;
     }
     (None, MAX_ITERATIONS)
 }
@@ -434,9 +432,9 @@ pub fn sample_solution(
 /// The weight `T / |det do/du|` of a solution without the medium's transmittance: Fresnel
 /// reflectance (`Reflect`), or both Fresnel transmittances with the radiance scaling `η_2² / η_1²`.
 pub fn geometric_weight(s: &GlintSolution) -> f64 {
-    let eta_1 = s.p1.eta;
+    let eta_1 = s.patches.p1.eta;
     let f_1 = fresnel(s.map.cos_1 as f32, eta_1 as f32).0 as f64;
-    let t = match (s.chain, s.map.out, s.p2) {
+    let t = match (s.chain, s.map.out, s.patches.p2) {
         (Chain::Reflect, _, _) => f_1,
         (Chain::Through, Some(out), Some(p2)) => {
             let f_2 = fresnel(out.cos_out as f32, p2.eta as f32).0 as f64;
@@ -446,7 +444,7 @@ pub fn geometric_weight(s: &GlintSolution) -> f64 {
             // The reflection from inside at x_2 (total when beyond the critical angle).
             let cos_2 = s.map.refl.map_or(0.0, |r| r.3);
             let f_2 = fresnel(-cos_2 as f32, p2.eta as f32).0 as f64;
-            let eta_3 = s.p3.map_or(p2.eta, |p| p.eta);
+            let eta_3 = s.patches.p3.map_or(p2.eta, |p| p.eta);
             let f_3 = fresnel(out.cos_out as f32, eta_3 as f32).0 as f64;
             (1.0 - f_1) * f_2 * (1.0 - f_3) * (eta_3 * eta_3) / (eta_1 * eta_1)
         }
@@ -809,6 +807,7 @@ pub(super) mod tests {
         let cone = std::f64::consts::TAU * (1.0 - theta.cos());
         let mut ball = Ball { eta: 1.5 };
         let p = ball.patch();
+        let all = Patches { p1: p, p2: Some(p), p3: Some(p) };
         let mut checked = 0;
         for (chain, omega_l) in cases() {
             {
@@ -818,7 +817,7 @@ pub(super) mod tests {
                 for y in 0..64 * 8 {
                     for x in 0..48 * 8 {
                         let u = DVec2::new(x as f64 + 0.5, y as f64 + 0.5) / 8.0;
-                        let Some(g) = glint_map(chain, &p, Some(&p), Some(&p), cam.origin, cam.direction(u)) else {
+                        let Some(g) = glint_map(chain, &all, cam.origin, cam.direction(u)) else {
                             continue;
                         };
                         if g.o.dot(omega_l) >= (3.0 * theta).cos() {
@@ -836,14 +835,13 @@ pub(super) mod tests {
                 for _ in 0..m {
                     let v = rng.next_2d();
                     let u = lo + (hi - lo) * DVec2::new(v.x as f64, v.y as f64);
-                    let Some(g) = glint_map(chain, &p, Some(&p), Some(&p), cam.origin, cam.direction(u)) else {
+                    let Some(g) = glint_map(chain, &all, cam.origin, cam.direction(u)) else {
                         continue;
                     };
                     if g.o.dot(omega_l) < theta.cos() {
                         continue;
                     }
-                    let s =
-                        GlintSolution { chain, u, map: g, p1: p, p2: Some(p), p3: Some(p), du_do: 1.0, iterations: 0 };
+                    let s = GlintSolution { chain, u, map: g, patches: all, du_do: 1.0, iterations: 0 };
                     let w = geometric_weight(&s) * area / cone;
                     sum += w;
                     sq += w * w;
