@@ -39,8 +39,7 @@ fn set_integrator(scene: &mut Scene, kind: IntegratorKind, connection: Connectio
 /// Every paper configuration (scenes/paper/*.xml, 12×16 pixels, 4 spp) with every integrator:
 /// per pixel and channel, the classes sum to the image up to float rounding (the image and the
 /// classes add the same contributions in another grouping: a few ulps of the largest term), each
-/// class's second moment is at least its squared mean (box filter: the mean of squared samples;
-/// not for `internal_reflection` where camera beams splat, docs/beams.md),
+/// class's second moment is at least its squared mean (box filter: the mean of squared samples),
 /// and `path` puts everything into `surface`.
 #[test]
 fn classes_sum_to_the_image_on_every_paper_configuration() {
@@ -69,9 +68,6 @@ fn classes_sum_to_the_image_on_every_paper_configuration() {
             set_integrator(&mut scene, kind, connection);
             let out = render_opts(&scene, 4, 11);
             let name = format!("{} {kind:?} {}", file.file_name().unwrap().to_string_lossy(), connection.name());
-            // Camera beams' splats (docs/beams.md) add `(C / pixels)²` to `internal_reflection.m2`: a
-            // variance term, not a square of a per-sample value, so there m2 ≥ mean² need not hold.
-            let splats = out.stats.to_json()["camera_beam_splats"].as_u64().unwrap() > 0;
             let mut non_surface = 0.0f32;
             for i in 0..out.width * out.height {
                 for c in ["R", "G", "B"] {
@@ -88,9 +84,6 @@ fn classes_sum_to_the_image_on_every_paper_configuration() {
                     for (k, v) in PathClass::ALL.iter().zip(&values) {
                         let m2 = channel(&out, &format!("{}.m2.{c}", k.name()), i);
                         assert!(v.is_finite() && m2.is_finite(), "{name}: non-finite {}", k.name());
-                        if splats && *k == PathClass::InternalReflection {
-                            continue;
-                        }
                         assert!(m2 >= v * v * (1.0 - 1e-5), "{name}: {}.m2.{c} = {m2} < mean² = {}", k.name(), v * v);
                     }
                     non_surface += values[1..].iter().map(|v| v.abs()).sum::<f32>();
