@@ -78,8 +78,10 @@ fn main() {
         let load = t0.elapsed().as_secs_f64();
         let (nodes, packets, depth) = scene.accel.stats();
         let bytes_per_tri = scene.accel.memory_bytes() as f64 / scene.triangle_count().max(1) as f64;
+        let brute = scene.accel.brute_triangles();
         eprintln!(
-            "{path}: {nodes} nodes, {packets} leaf packets, depth {depth}, {bytes_per_tri:.1} bytes per triangle"
+            "{path}: {nodes} nodes, {packets} leaf packets, depth {depth}, {bytes_per_tri:.1} bytes per triangle, \
+             {brute} triangles by brute force"
         );
         let shapes = &scene.shapes;
         let mut s = Sampler::new(3, 0);

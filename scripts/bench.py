@@ -205,7 +205,7 @@ SUITE = [
     ("scenes/paper/sphere_smooth_st34.xml", "volpath", 8),
     ("scenes/paper/sphere_smooth_st34.xml", "volpath_snee", 8),
 ]
-TRAVERSAL_SCENES = ["scenes/cornell_box.xml", "scenes/paper/sphere_smooth_st02.xml"]
+TRAVERSAL_SCENES = ["scenes/cornell_box.xml", "scenes/media_null.xml", "scenes/paper/sphere_smooth_st02.xml"]
 
 
 def callgrind_instructions(binary, scene, function, rays):

@@ -2,12 +2,15 @@
 //! parallel binned-SAH builder, [`build`]), traversed nearest first with an AVX node test when the
 //! CPU has AVX2 (run-time detection; SSE otherwise) ([`traverse`]), with leaves of four triangles tested at once by the watertight test of Woop,
 //! Benthin & Wald 2013 ([`triangle`]). Analytic shapes (spheres, disks) stay out of the BVH and are
-//! tested directly before it, in `f32`; scenes are expected to hold few of them.
+//! tested directly before it, in `f32`; scenes are expected to hold few of them. A tree of at
+//! most sixteen triangles is not traversed: every triangle is tested at once, in one AVX-512
+//! register or two AVX2 halves ([`brute`]).
 //!
 //! Watertightness: primitive boxes are padded, the node test is conservative (Ize 2013) and the
 //! triangle test is watertight, so no ray slips through a shared edge or vertex of a closed mesh
 //! (`tests/accel.rs` checks 1.4 M rays through a closed 1.3 M-triangle sphere).
 
+pub mod brute;
 pub mod build;
 pub mod bvh8;
 pub mod traverse;
@@ -15,6 +18,7 @@ pub mod triangle;
 
 use super::{Geometry, Shape};
 use crate::math::Ray;
+use brute::Brute;
 use build::Bounds;
 use bvh8::{Bvh8, LaneShade, LEAF_SIZE};
 use glam::Vec3A;
@@ -114,6 +118,8 @@ pub struct Accel {
     deep: bool,
     /// The tree is larger than `traverse::PREFETCH_BYTES`: traversals prefetch stack entries.
     prefetch: bool,
+    /// A tiny tree's triangles for brute-force queries (`brute.rs`; AVX2 and AVX-512 only).
+    brute: Option<Brute>,
 }
 
 /// A sphere tested outside the BVH: centre and r² (16-byte vectors: the test runs in SSE lanes).
@@ -130,8 +136,15 @@ impl Accel {
     }
 
     /// Build with the given node-test ISA (capped at what the CPU supports: `Isa::Avx512` falls
-    /// back to `Isa::Avx2`, and that to `Isa::Portable`).
+    /// back to `Isa::Avx2`, and that to `Isa::Portable`), with brute force for a tiny tree unless
+    /// the environment variable `SNEE_BRUTE` is `off` (for measuring one against the other).
     pub fn build_with(shapes: &[Shape], isa: Isa) -> Accel {
+        Self::build_opts(shapes, isa, std::env::var("SNEE_BRUTE").as_deref() != Ok("off"))
+    }
+
+    /// [`Accel::build_with`], with brute force for a tree of at most `brute::MAX_TRIANGLES`
+    /// triangles when `brute` (and the ISA is AVX2 or AVX-512), the tree's traversal otherwise.
+    pub fn build_opts(shapes: &[Shape], isa: Isa, brute: bool) -> Accel {
         let isa = isa.min(Isa::detect());
         // Per mesh: (first builder index, shape index); the builder numbers the triangles of the
         // meshes one after another.
@@ -171,7 +184,8 @@ impl Accel {
         });
         let deep = bvh.as_ref().is_some_and(|b| traverse::stack_size(b.depth) > STACK);
         let prefetch = bvh.as_ref().is_some_and(|b| b.memory_bytes() > traverse::PREFETCH_BYTES);
-        Accel { bvh, spheres, disks, isa, deep, prefetch }
+        let brute = if brute && isa >= Isa::Avx2 { bvh.as_ref().and_then(Brute::new) } else { None };
+        Accel { bvh, spheres, disks, isa, deep, prefetch, brute }
     }
 
     /// Bytes of the BVH (nodes, triangle packets, per-lane shape and triangle).
@@ -187,6 +201,11 @@ impl Accel {
         let (packet, l) = (lane as usize / LEAF_SIZE, lane as usize % LEAF_SIZE);
         let (record, v) = (bvh.lanes.get(packet)?, &bvh.packets.get(packet)?.v);
         Some((&record[l], [0, 1, 2].map(|j| Vec3A::new(v[j][0][l], v[j][1][l], v[j][2][l]))))
+    }
+
+    /// Triangles tested by brute force instead of the tree (0: the tree is traversed).
+    pub fn brute_triangles(&self) -> usize {
+        self.brute.as_ref().map_or(0, Brute::triangles)
     }
 
     /// BVH nodes, leaf packets and depth.
@@ -264,6 +283,17 @@ impl Accel {
     /// ray's precomputation happens inside it), prefetching stack entries in a large tree.
     #[inline(always)]
     fn closest(&self, bvh: &Bvh8, ray: &Ray, tmax: f32) -> Found {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(brute) = &self.brute {
+            // SAFETY: `brute` is built only for `Isa::Avx2` and above, capped at the CPU's.
+            return unsafe {
+                if self.isa == Isa::Avx512 {
+                    brute.closest_avx512(ray, tmax)
+                } else {
+                    brute.closest_avx2(ray, tmax)
+                }
+            };
+        }
         if self.deep {
             return closest_deep(bvh, ray, tmax, self.isa);
         }
@@ -273,6 +303,17 @@ impl Accel {
 
     #[inline(always)]
     fn any(&self, bvh: &Bvh8, ray: &Ray) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(brute) = &self.brute {
+            // SAFETY: as in `closest`.
+            return unsafe {
+                if self.isa == Isa::Avx512 {
+                    brute.any_avx512(ray)
+                } else {
+                    brute.any_avx2(ray)
+                }
+            };
+        }
         if self.deep {
             return any_deep(bvh, ray, self.isa);
         }

@@ -193,6 +193,14 @@ impl WatertightRay {
         Self::with_inverse(-o, d, Vec4::ONE / d0)
     }
 
+    /// The axes (kx, ky, kz) as indices, the shear (sx, sy, sz) and −o in the permuted axes: the
+    /// state as plain numbers, for tests on other layouts (`brute.rs`).
+    #[inline(always)]
+    pub fn parts(&self) -> ([usize; 3], [f32; 3], [f32; 3]) {
+        let (s, o) = (self.s.to_array(), self.neg_o.to_array());
+        (self.k.map(|k| k / 16), [s[0], s[1], s[2]], [o[0], o[1], o[2]])
+    }
+
     /// The test's state from axes `k` and shear `s` as [`shear_axes`] gives them.
     pub fn from_parts(k: [usize; 3], s: [f32; 3], o: Vec3) -> Self {
         assert!(k.iter().all(|&a| a < 3), "axes {k:?}");
