@@ -8,7 +8,7 @@
 //! culls a box the ray touches, and a zero direction component gives a finite inverse (no NaN
 //! from 0 · ∞).
 
-use super::bvh8::{Bvh8, LaneShade, Node8, EMPTY, LEAF};
+use super::bvh8::{Bvh8, LaneShade, Node8, EMPTY, LEAF, LEAF_SIZE};
 use super::triangle::WatertightRay;
 use crate::math::{Ray, Vec3};
 use glam::Vec4;
@@ -469,6 +469,15 @@ macro_rules! closest_body {
             }
             if cur < DONE {
                 let packet = (cur & !LEAF) as usize;
+                if PF {
+                    // In a large tree, the packet's four lane records (256 bytes) are requested
+                    // with the packet itself, so that a hit's record, which the hit record reads
+                    // right after the traversal, is not one more miss after the packet's.
+                    let lanes = bvh.lanes.as_ptr().wrapping_add(packet).cast::<LaneShade>();
+                    for l in 0..LEAF_SIZE {
+                        prefetch(lanes.wrapping_add(l));
+                    }
+                }
                 if let Some((lane, t, b1, b2)) = leaf!($nearest, wt, at!($chk, bvh.packets, packet), tmax) {
                     (hit_lane, tmax, hit_b1, hit_b2) = ((4 * packet + lane) as u32, t, b1, b2);
                     prefetch(bvh.lanes.as_ptr().wrapping_add(packet).cast::<LaneShade>().wrapping_add(lane));
