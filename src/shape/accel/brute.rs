@@ -20,9 +20,10 @@ use crate::math::Ray;
 pub const WIDTH: usize = 16;
 
 /// The largest triangle count tested by brute force: one group. Chosen by measurement (render
-/// time of 9 interleaved pairs at 1 thread, AVX-512; callgrind for AVX2): `media_null` (14
-/// triangles) −6 % time and −8 % instructions; `cornell_box` (36 triangles, three groups) the same
-/// time with AVX-512 and +27 % instructions with AVX2.
+/// time, interleaved pairs at 1 thread, AVX-512; callgrind for AVX2): `media_null` (14 triangles)
+/// −6 to −10 % time and −8 % instructions; `cornell_box` (36 triangles, three groups) the same time
+/// with AVX-512 (11 pairs, median ratio 0.99) and +27 % instructions with AVX2, so it stays on the
+/// tree.
 pub const MAX_TRIANGLES: usize = WIDTH;
 
 /// Sixteen triangles, one lane each: `v[vertex][axis][lane]`; an unused lane holds NaN vertices,
@@ -85,30 +86,42 @@ impl Brute {
     /// The CPU must support AVX-512F (`Isa::Avx512`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,bmi1")]
-    pub unsafe fn closest_avx512(&self, ray: &Ray, mut tmax: f32) -> Found {
+    pub unsafe fn closest_avx512(&self, ray: &Ray, tmax: f32) -> Found {
         use std::arch::x86_64::*;
         let sh = Sheared::new(ray);
-        let mut found = Found { lane: u32::MAX, t: tmax, b1: 0.0, b2: 0.0 };
+        // Every group tested against `tmax` (independent tests, so they overlap in the core), and
+        // per lane slot the nearest over the groups kept (strictly nearer: ties to the earlier
+        // group), with its group's lane index.
+        let iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+        let (mut best_t, mut best_b1, mut best_b2) =
+            (_mm512_set1_ps(f32::INFINITY), _mm512_setzero_ps(), _mm512_setzero_ps());
+        let (mut best_i, mut any) = (_mm512_setzero_si512(), 0u16);
         for (g, group) in self.groups.iter().enumerate() {
             let (ok, t, b1, b2) = test16(&sh, group, tmax);
-            if ok == 0 {
-                continue;
-            }
-            // The nearest hit lane, ties to the lowest: most rays hit one lane of a group.
-            let l = if ok & (ok - 1) == 0 {
-                ok.trailing_zeros()
-            } else {
-                let t_hit = _mm512_mask_mov_ps(_mm512_set1_ps(f32::INFINITY), ok, t);
-                let at_min =
-                    _mm512_mask_cmp_ps_mask::<_CMP_EQ_OQ>(ok, t_hit, _mm512_set1_ps(_mm512_reduce_min_ps(t_hit)));
-                at_min.trailing_zeros()
-            };
-            let pick = |x: __m512| _mm512_cvtss_f32(_mm512_permutexvar_ps(_mm512_set1_epi32(l as i32), x));
-            tmax = pick(t);
-            let lane = self.lane[g * WIDTH + (l as usize & (WIDTH - 1))];
-            found = Found { lane, t: tmax, b1: pick(b1), b2: pick(b2) };
+            let m = _mm512_mask_cmp_ps_mask::<_CMP_LT_OQ>(ok, t, best_t);
+            best_t = _mm512_mask_mov_ps(best_t, m, t);
+            best_b1 = _mm512_mask_mov_ps(best_b1, m, b1);
+            best_b2 = _mm512_mask_mov_ps(best_b2, m, b2);
+            best_i = _mm512_mask_mov_epi32(best_i, m, _mm512_add_epi32(iota, _mm512_set1_epi32((g * WIDTH) as i32)));
+            any |= ok;
         }
-        found
+        if any == 0 {
+            return Found { lane: u32::MAX, t: tmax, b1: 0.0, b2: 0.0 };
+        }
+        // The nearest slot; among slots at exactly the same distance the lowest lane index, so
+        // the hit is the first nearest lane in build order, as testing the lanes one by one gives.
+        let t_min = if any & (any - 1) == 0 { f32::INFINITY } else { _mm512_reduce_min_ps(best_t) };
+        let at_min =
+            if any & (any - 1) == 0 { any } else { _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(best_t, _mm512_set1_ps(t_min)) };
+        let slot = if at_min & (at_min - 1) == 0 {
+            at_min.trailing_zeros()
+        } else {
+            let i = _mm512_mask_mov_epi32(_mm512_set1_epi32(i32::MAX), at_min, best_i);
+            (_mm512_reduce_min_epi32(i) as u32) % WIDTH as u32
+        };
+        let pick = |x: __m512| _mm512_cvtss_f32(_mm512_permutexvar_ps(_mm512_set1_epi32(slot as i32), x));
+        let i = _mm512_cvtsi512_si32(_mm512_permutexvar_epi32(_mm512_set1_epi32(slot as i32), best_i)) as usize;
+        Found { lane: self.lane[i % self.lane.len()], t: pick(best_t), b1: pick(best_b1), b2: pick(best_b2) }
     }
 
     /// True when a triangle is hit in (0, ray.tmax), AVX-512.
