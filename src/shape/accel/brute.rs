@@ -11,7 +11,7 @@
 //! lane in build order wins, where the tree takes the one in the leaf it visits first (such ties
 //! need two triangles hit at the same `f32` distance).
 
-use super::bvh8::{Bvh8, LEAF_SIZE};
+use super::bvh8::{Bvh8, LEAF, LEAF_SIZE};
 use super::traverse::Found;
 use super::triangle::WatertightRay;
 use crate::math::Ray;
@@ -51,8 +51,12 @@ struct Sheared {
 }
 
 impl Brute {
-    /// The BVH's used lanes in packet order, or `None` when it holds more than [`MAX_TRIANGLES`].
+    /// The BVH's used lanes in packet order, or `None` when it holds more than [`MAX_TRIANGLES`]
+    /// or is one leaf packet (whose four-wide test is the whole traversal, cheaper than a group's).
     pub fn new(bvh: &Bvh8) -> Option<Brute> {
+        if bvh.root & LEAF != 0 {
+            return None;
+        }
         let used: Vec<(usize, usize)> = (0..bvh.packets.len())
             .flat_map(|p| (0..LEAF_SIZE).map(move |l| (p, l)))
             .filter(|&(p, l)| bvh.lanes[p][l].shape != u32::MAX)
