@@ -19,8 +19,10 @@ should agree up to noise), and everything is written to OUT/bench.json.
 
 Several scenes can be given: each is timed as above (Mitsuba's warm-up is per scene, since every
 scene compiles its own kernels) and a Markdown table of all of them is printed at the end.
-`--repeat K` renders each scene K times with both renderers and keeps the fastest run of each
-(the machine is shared; the minimum is the least disturbed measurement).
+`--repeat K` renders each scene K times with both renderers, interleaved (snee, Mitsuba, snee, ...,
+after Mitsuba's warm-up), and reports the fastest run of each and the median and range of the K
+paired ratios (the machine is shared: the minimum is the least disturbed measurement, the paired
+median the one least moved by load that changes between runs).
 
 Suite (`--suite`, the default without scene arguments): the speed table of the README in one run:
 cornell_box, glass_envmap, media_null, media_rough_glass and the paper statue (sphere light, smooth
@@ -54,11 +56,10 @@ import common
 from common import MAX_SAMPLES_PER_PASS, ROOT
 
 
-def run_snee(args, scene, out_dir):
+def snee_command(args, scene, out_dir):
+    """The snee render command for `scene`, its EXR and its stats file."""
     exr = os.path.join(out_dir, "snee.exr")
     stats_path = os.path.join(out_dir, "snee_stats.json")
-    if os.path.exists(stats_path):
-        os.remove(stats_path)
     if args.snee:
         cmd = [args.snee]
     else:
@@ -71,25 +72,26 @@ def run_snee(args, scene, out_dir):
     for name, value in args.defines:
         cmd += ["-D", f"{name}={value}"]
     print("running:", " ".join(shlex.quote(c) for c in cmd), flush=True)
-    best = None
-    for _ in range(args.repeat):
-        t0 = time.perf_counter()
-        proc = subprocess.run(cmd, cwd=ROOT)
-        wall = time.perf_counter() - t0
-        if proc.returncode != 0:
-            sys.exit(f"snee failed with exit code {proc.returncode}")
-        with open(stats_path) as fh:
-            stats = json.load(fh)
-        for key in ("seconds", "spp", "samples_per_second"):
-            if key not in stats:
-                sys.exit(f"{stats_path}: missing key {key!r} (has {sorted(stats)})")
-        if best is None or float(stats["seconds"]) < float(best[1]["seconds"]):
-            best = (wall, stats)
-    wall, stats = best
+    return cmd, exr, stats_path
+
+
+def snee_once(args, cmd, stats_path):
+    """One snee render: (process wall seconds, its stats)."""
+    if os.path.exists(stats_path):
+        os.remove(stats_path)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=ROOT)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        sys.exit(f"snee failed with exit code {proc.returncode}")
+    with open(stats_path) as fh:
+        stats = json.load(fh)
+    for key in ("seconds", "spp", "samples_per_second"):
+        if key not in stats:
+            sys.exit(f"{stats_path}: missing key {key!r} (has {sorted(stats)})")
     if int(stats["spp"]) != args.spp:
         print(f"warning: snee rendered {stats['spp']} spp, asked for {args.spp}", file=sys.stderr)
-    return dict(seconds=float(stats["seconds"]), wall_seconds=wall, spp=int(stats["spp"]),
-                samples_per_second=float(stats["samples_per_second"]), image=exr, stats=stats)
+    return wall, stats
 
 
 def mitsuba_render(mi, scene, spp, seed):
@@ -106,32 +108,53 @@ def mitsuba_render(mi, scene, spp, seed):
     return acc / spp
 
 
-def run_mitsuba(args, mi, variant, scene_path, out_dir):
+def timed_pairs(args, mi, variant, scene_path, out_dir):
+    """Mitsuba's scene loaded and its kernels compiled (a warm-up render, not timed), then
+    `--repeat` rounds of one snee render and one Mitsuba render, interleaved so that both see the
+    same machine state. Returns (snee, mitsuba, per-round ratios snee / Mitsuba)."""
+    cmd, exr, stats_path = (None, None, None) if args.skip_snee else snee_command(args, scene_path, out_dir)
     scene = mi.load_file(scene_path, **{k: v for k, v in args.mitsuba_defines})
+    w, h = scene.sensors()[0].film().crop_size()
+    import drjit as dr
     if args.threads_now:
         # Only around the renders: Mitsuba 3.9.1 deadlocks reading or writing EXR files with
         # Dr.Jit's pool at one thread.
-        import drjit as dr
         dr.set_thread_count(args.threads_now)
-    w, h = scene.sensors()[0].film().crop_size()
-    t0 = time.perf_counter()
-    mitsuba_render(mi, scene, min(args.spp, max(1, MAX_SAMPLES_PER_PASS // (w * h))), seed=1)
-    warmup = time.perf_counter() - t0
-    seconds, img = None, None
-    for k in range(args.repeat):
+    try:
         t0 = time.perf_counter()
-        im = mitsuba_render(mi, scene, args.spp, seed=2 + k)
-        dt = time.perf_counter() - t0
-        if seconds is None or dt < seconds:
-            seconds, img = dt, im
-    if args.threads_now:
-        import drjit as dr
-        dr.set_thread_count(os.cpu_count())
-    exr = os.path.join(out_dir, "mitsuba.exr")
-    mi.Bitmap(img[..., :3].astype(np.float32)).write(exr)
-    return dict(seconds=seconds, warmup_seconds=warmup, spp=args.spp, variant=variant,
-                samples_per_second=w * h * args.spp / seconds, image=exr, width=w, height=h,
+        mitsuba_render(mi, scene, min(args.spp, max(1, MAX_SAMPLES_PER_PASS // (w * h))), seed=1)
+        warmup = time.perf_counter() - t0
+        snee_best, m_seconds, img, ratios, m_all, s_all = None, None, None, [], [], []
+        for k in range(args.repeat):
+            s_seconds = None
+            if cmd is not None:
+                wall, stats = snee_once(args, cmd, stats_path)
+                s_seconds = float(stats["seconds"])
+                s_all.append(s_seconds)
+                if snee_best is None or s_seconds < float(snee_best[1]["seconds"]):
+                    snee_best = (wall, stats)
+            t0 = time.perf_counter()
+            im = mitsuba_render(mi, scene, args.spp, seed=2 + k)
+            dt = time.perf_counter() - t0
+            m_all.append(dt)
+            if s_seconds is not None:
+                ratios.append(s_seconds / dt)
+            if m_seconds is None or dt < m_seconds:
+                m_seconds, img = dt, im
+    finally:
+        if args.threads_now:
+            dr.set_thread_count(os.cpu_count())
+    m_exr = os.path.join(out_dir, "mitsuba.exr")
+    mi.Bitmap(img[..., :3].astype(np.float32)).write(m_exr)
+    mits = dict(seconds=m_seconds, all_seconds=m_all, warmup_seconds=warmup, spp=args.spp, variant=variant,
+                samples_per_second=w * h * args.spp / m_seconds, image=m_exr, width=w, height=h,
                 mitsuba_version=mi.__version__)
+    snee = None
+    if snee_best is not None:
+        wall, stats = snee_best
+        snee = dict(seconds=float(stats["seconds"]), all_seconds=s_all, wall_seconds=wall, spp=int(stats["spp"]),
+                    samples_per_second=float(stats["samples_per_second"]), image=exr, stats=stats)
+    return snee, mits, ratios
 
 
 def mean_rgb(mi, path):
@@ -148,8 +171,7 @@ def bench_scene(args, mi, variant, scene):
     out_dir = os.path.abspath(os.path.join(args.out, tag))
     os.makedirs(out_dir, exist_ok=True)
 
-    snee = None if args.skip_snee else run_snee(args, scene, out_dir)
-    mits = run_mitsuba(args, mi, variant, scene, out_dir)
+    snee, mits, ratios = timed_pairs(args, mi, variant, scene, out_dir)
 
     px = mits["width"] * mits["height"]
     print(f"\nscene {os.path.relpath(scene, ROOT)}: {mits['width']}x{mits['height']}, "
@@ -166,9 +188,12 @@ def bench_scene(args, mi, variant, scene):
         print(f"  {'snee':8s} {snee['seconds']:9.3f} {snee['samples_per_second'] / 1e6:11.3f}  "
               f"{np.round(s_mean, 4).tolist()}  (process wall time {snee['wall_seconds']:.2f} s)")
         ratio = snee["seconds"] / mits["seconds"]
-        print(f"  time ratio snee / mitsuba = {ratio:.3f}  "
+        median = float(np.median(ratios))
+        print(f"  time ratio snee / mitsuba = {ratio:.3f} (fastest of each), {median:.3f} (median of "
+              f"{len(ratios)} interleaved pairs, range {min(ratios):.3f}-{max(ratios):.3f})  "
               f"({'snee' if ratio < 1 else 'mitsuba'} is {max(ratio, 1 / ratio):.2f}x faster)")
-        result.update(snee=snee, ratio_seconds=ratio, mean_rgb_snee=s_mean.tolist())
+        result.update(snee=snee, ratio_seconds=ratio, ratio_median=median, ratios=ratios,
+                      mean_rgb_snee=s_mean.tolist())
     result.update(mean_rgb_mitsuba=m_mean.tolist())
     path = os.path.join(out_dir, "bench.json")
     with open(path, "w") as fh:
@@ -180,8 +205,9 @@ def bench_scene(args, mi, variant, scene):
 
 def print_table(results):
     print("\n| scene | integrator (snee) | threads | size | spp | snee render s | snee Msamples/s | "
-          "snee process s | Mitsuba s | Mitsuba Msamples/s | Mitsuba JIT warm-up s (excluded) | snee / Mitsuba |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "snee process s | Mitsuba s | Mitsuba Msamples/s | Mitsuba JIT warm-up s (excluded) | snee / Mitsuba | "
+          "median of paired ratios (range) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in results:
         m = r["mitsuba"]
         s = r.get("snee")
@@ -190,7 +216,8 @@ def print_table(results):
                  f"{s['seconds']:.2f}" if s else "-", f"{s['samples_per_second'] / 1e6:.3f}" if s else "-",
                  f"{s['wall_seconds']:.2f}" if s else "-",
                  f"{m['seconds']:.2f}", f"{m['samples_per_second'] / 1e6:.3f}", f"{m['warmup_seconds']:.2f}",
-                 f"{r['ratio_seconds']:.2f}" if s else "-"]
+                 f"{r['ratio_seconds']:.2f}" if s else "-",
+                 f"{r['ratio_median']:.2f} ({min(r['ratios']):.2f}–{max(r['ratios']):.2f})" if s else "-"]
         print("| " + " | ".join(cells) + " |")
 
 
@@ -289,7 +316,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench"),
                     help="output folder for images and bench.json (default: out/bench)")
     ap.add_argument("--repeat", type=int, default=1,
-                    help="render each scene this many times per renderer, keep the fastest (default 1)")
+                    help="render each scene this many times per renderer, snee and Mitsuba interleaved; "
+                         "the table shows the fastest of each and the median of the paired ratios (default 1)")
     ap.add_argument("--skip-snee", action="store_true", help="only time Mitsuba")
     args = ap.parse_args()
     if args.repeat < 1:

@@ -13,7 +13,7 @@
 
 use super::bvh8::{Bvh8, LEAF, LEAF_SIZE};
 use super::traverse::Found;
-use super::triangle::WatertightRay;
+use super::triangle::{nearest_of, WatertightRay};
 use crate::math::Ray;
 
 /// Lanes per group.
@@ -150,21 +150,12 @@ impl Brute {
         let mut found = Found { lane: u32::MAX, t: tmax, b1: 0.0, b2: 0.0 };
         for (g, group) in self.groups.iter().enumerate() {
             for half in 0..2 {
-                let (mut ok, t, b1, b2) = test8(&sh, group, half, tmax);
+                let (ok, t, b1, b2) = test8(&sh, group, half, tmax);
                 if ok == 0 {
                     continue;
                 }
                 let (t, b1, b2) = (to_array8(t), to_array8(b1), to_array8(b2));
-                // The nearest hit lane, ties to the lowest (lanes in ascending order, strict `<`).
-                let mut best = ok.trailing_zeros() as usize & 7;
-                ok &= ok - 1;
-                while ok != 0 {
-                    let l = ok.trailing_zeros() as usize & 7;
-                    ok &= ok - 1;
-                    if t[l] < t[best] {
-                        best = l;
-                    }
-                }
+                let best = nearest_of(ok, &t);
                 tmax = t[best];
                 let lane = self.lane[g * WIDTH + 8 * half + best];
                 found = Found { lane, t: t[best], b1: b1[best], b2: b2[best] };

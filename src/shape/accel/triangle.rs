@@ -120,23 +120,31 @@ fn edges_f64(ray: WatertightRay, p: &TriPacket4, lanes: u32, uvw: [Vec4; 3]) -> 
 
 /// The nearest of the hit lanes `mask` (ties to the lowest): (lane, t, b1, b2).
 #[inline(always)]
-fn nearest_lane(mut mask: u32, t: Vec4, b1: Vec4, b2: Vec4) -> Option<(usize, f32, f32, f32)> {
+fn nearest_lane(mask: u32, t: Vec4, b1: Vec4, b2: Vec4) -> Option<(usize, f32, f32, f32)> {
     if mask == 0 {
         return None;
     }
-    let t = t.to_array();
-    // `& 3`: the lanes of a 4-bit mask (free where the compiler knows `mask < 16`; elsewhere it
-    // replaces a bounds check).
-    let mut best = mask.trailing_zeros() as usize & 3;
+    let best = nearest_of(mask, &t.to_array());
+    Some((best, t.to_array()[best], b1.to_array()[best], b2.to_array()[best]))
+}
+
+/// The lane of the smallest `t` among the lanes of the non-zero `mask`, ties to the lowest (the
+/// lanes in ascending order, replaced only by a strictly smaller `t`). `N` is a power of two.
+#[inline(always)]
+pub fn nearest_of<const N: usize>(mut mask: u32, t: &[f32; N]) -> usize {
+    debug_assert!(mask != 0 && N.is_power_of_two());
+    // `& (N − 1)`: the lanes of an N-bit mask (free where the compiler knows the mask's width;
+    // elsewhere it replaces a bounds check).
+    let mut best = mask.trailing_zeros() as usize & (N - 1);
     mask &= mask - 1;
     while mask != 0 {
-        let l = mask.trailing_zeros() as usize & 3;
+        let l = mask.trailing_zeros() as usize & (N - 1);
         mask &= mask - 1;
         if t[l] < t[best] {
             best = l;
         }
     }
-    Some((best, t[best], b1.to_array()[best], b2.to_array()[best]))
+    best
 }
 
 /// The packet test after the edge functions `uvw` (and the sheared z coordinates `z` of the three
