@@ -6,7 +6,7 @@ use crate::color::Spectrum;
 use crate::emitter::{area, Emitter};
 use crate::integrator::desc::Integrator;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
-use crate::math::{Aabb, Ray, Vec2, Vec3};
+use crate::math::{Aabb, Ray, RayA, Vec2, Vec3};
 use crate::medium::Homogeneous;
 use crate::sensor::film::Film;
 use crate::sensor::sampler_desc::SamplerDesc;
@@ -80,26 +80,28 @@ impl Scene {
         #[cfg(target_arch = "x86_64")]
         if self.ray_avx2 {
             // SAFETY: `ray_avx2` is only set where the CPU supports AVX2 (`ray_avx2_supported`).
-            return unsafe { self.ray_intersect_avx2(ray) };
+            return unsafe { self.ray_intersect_avx2(&ray.to_a()) };
         }
-        self.ray_intersect_base(ray)
+        self.ray_intersect_base(&ray.to_a())
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[inline(never)]
-    unsafe fn ray_intersect_avx2(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+    unsafe fn ray_intersect_avx2(&self, ray: &RayA) -> Option<SurfaceInteraction> {
         self.ray_intersect_impl(ray)
     }
 
     #[inline(never)]
-    fn ray_intersect_base(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+    fn ray_intersect_base(&self, ray: &RayA) -> Option<SurfaceInteraction> {
         self.ray_intersect_impl(ray)
     }
 
     #[inline(always)]
-    fn ray_intersect_impl(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let hit = self.accel.intersect_inline(&self.shapes, ray)?;
+    /// (The ray as a [`RayA`]: this body is behind a call that does not inline, see `RayA`.)
+    fn ray_intersect_impl(&self, ray_a: &RayA) -> Option<SurfaceInteraction> {
+        let hit = self.accel.intersect_a(&self.shapes, ray_a)?;
+        let ray = &ray_a.ray();
         // Each arm returns its record whole (built in the return slot, not copied there). The same
         // dispatch as `Shape::interaction`, written out: calling that with the shape set by struct
         // update compiles the volpath loop around it worse (statue σt 2 `volpath`, 4 spp: +0.9 %

@@ -14,7 +14,7 @@
 use super::bvh8::{Bvh8, LEAF, LEAF_SIZE};
 use super::traverse::Found;
 use super::triangle::{nearest_of, WatertightRay};
-use crate::math::Ray;
+use crate::math::RayA;
 
 /// Lanes per group.
 pub const WIDTH: usize = 16;
@@ -90,7 +90,7 @@ impl Brute {
     /// The CPU must support AVX-512F (`Isa::Avx512`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,bmi1")]
-    pub unsafe fn closest_avx512(&self, ray: &Ray, tmax: f32) -> Found {
+    pub unsafe fn closest_avx512(&self, ray: &RayA, tmax: f32) -> Found {
         use std::arch::x86_64::*;
         let sh = Sheared::new(ray);
         // Every group tested against `tmax` (independent tests, so they overlap in the core), and
@@ -134,7 +134,7 @@ impl Brute {
     /// As for [`Brute::closest_avx512`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,bmi1")]
-    pub unsafe fn any_avx512(&self, ray: &Ray) -> bool {
+    pub unsafe fn any_avx512(&self, ray: &RayA) -> bool {
         let sh = Sheared::new(ray);
         self.groups.iter().any(|group| test16(&sh, group, ray.tmax).0 != 0)
     }
@@ -145,7 +145,7 @@ impl Brute {
     /// The CPU must support AVX2 (`Isa::Avx2`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,bmi1,popcnt")]
-    pub unsafe fn closest_avx2(&self, ray: &Ray, mut tmax: f32) -> Found {
+    pub unsafe fn closest_avx2(&self, ray: &RayA, mut tmax: f32) -> Found {
         let sh = Sheared::new(ray);
         let mut found = Found { lane: u32::MAX, t: tmax, b1: 0.0, b2: 0.0 };
         for (g, group) in self.groups.iter().enumerate() {
@@ -170,7 +170,7 @@ impl Brute {
     /// As for [`Brute::closest_avx2`].
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2,fma,bmi1,popcnt")]
-    pub unsafe fn any_avx2(&self, ray: &Ray) -> bool {
+    pub unsafe fn any_avx2(&self, ray: &RayA) -> bool {
         let sh = Sheared::new(ray);
         self.groups.iter().any(|group| test8(&sh, group, 0, ray.tmax).0 != 0 || test8(&sh, group, 1, ray.tmax).0 != 0)
     }
@@ -179,8 +179,8 @@ impl Brute {
 impl Sheared {
     /// The state of [`WatertightRay::new`] (the same axes, shear and origin bits).
     #[inline(always)]
-    fn new(ray: &Ray) -> Sheared {
-        let (k, s, neg_o) = WatertightRay::new(ray.o, ray.d).parts();
+    fn new(ray: &RayA) -> Sheared {
+        let (k, s, neg_o) = WatertightRay::new(ray.o.into(), ray.d.into()).parts();
         Sheared { k, s, neg_o }
     }
 }

@@ -17,7 +17,7 @@ pub mod traverse;
 pub mod triangle;
 
 use super::{Geometry, Shape};
-use crate::math::Ray;
+use crate::math::{Ray, RayA};
 use brute::Brute;
 use build::Bounds;
 use bvh8::{Bvh8, LaneShade, LEAF_SIZE};
@@ -224,9 +224,15 @@ impl Accel {
         self.occluded_inline(shapes, ray)
     }
 
-    /// Closest hit along the ray in (0, ray.tmax), inlined into the caller (`Scene::ray_intersect`).
+    /// Closest hit along the ray in (0, ray.tmax), inlined into the caller.
     #[inline(always)]
     pub fn intersect_inline(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
+        self.intersect_a(shapes, &ray.to_a())
+    }
+
+    /// [`Accel::intersect_inline`] of a [`RayA`] (`Scene::ray_intersect`'s bodies take it so).
+    #[inline(always)]
+    pub fn intersect_a(&self, shapes: &[Shape], ray: &RayA) -> Option<Hit> {
         // A NaN or infinite ray has no hit; the traversal's nearest-first order needs finite distances.
         if !ray_is_finite(ray) {
             return None;
@@ -239,6 +245,7 @@ impl Accel {
     /// True when anything blocks the ray in (0, ray.tmax), inlined into the caller (`Scene::ray_test`).
     #[inline(always)]
     pub fn occluded_inline(&self, shapes: &[Shape], ray: &Ray) -> bool {
+        let ray = &ray.to_a();
         // A NaN or infinite ray carries no light: report it blocked.
         if !ray_is_finite(ray) {
             return true;
@@ -254,10 +261,10 @@ impl Accel {
     /// comes first, so the hit is the one of the lowest shape index among the nearest, as a test
     /// of the shapes in scene order gives it.
     #[inline(always)]
-    fn analytic_closest(&self, shapes: &[Shape], ray: &Ray) -> (Option<Hit>, f32) {
+    fn analytic_closest(&self, shapes: &[Shape], ray: &RayA) -> (Option<Hit>, f32) {
         let mut best: Option<Hit> = None;
         let mut tmax = ray.tmax;
-        let (o, d) = (Vec3A::from(ray.o), Vec3A::from(ray.d));
+        let (o, d) = (ray.o, ray.d);
         for s in &self.spheres {
             if let Some(t) = super::sphere::intersect_sphere_a(s.center, s.r2, o, d, tmax) {
                 if t < tmax {
@@ -273,8 +280,8 @@ impl Accel {
     }
 
     #[inline(always)]
-    fn analytic_any(&self, shapes: &[Shape], ray: &Ray) -> bool {
-        let (o, d) = (Vec3A::from(ray.o), Vec3A::from(ray.d));
+    fn analytic_any(&self, shapes: &[Shape], ray: &RayA) -> bool {
+        let (o, d) = (ray.o, ray.d);
         self.spheres.iter().any(|s| super::sphere::intersect_sphere_a(s.center, s.r2, o, d, ray.tmax).is_some())
             || (!self.disks.is_empty() && disks_any(&self.disks, shapes, ray))
     }
@@ -282,7 +289,7 @@ impl Accel {
     /// The BVH's closest hit in (0, tmax): one call into the traversal compiled for the CPU (the
     /// ray's precomputation happens inside it), prefetching stack entries in a large tree.
     #[inline(always)]
-    fn closest(&self, bvh: &Bvh8, ray: &Ray, tmax: f32) -> Found {
+    fn closest(&self, bvh: &Bvh8, ray: &RayA, tmax: f32) -> Found {
         #[cfg(target_arch = "x86_64")]
         if let Some(brute) = &self.brute {
             // SAFETY: `brute` is built only for `Isa::Avx2` and above, capped at the CPU's.
@@ -302,7 +309,7 @@ impl Accel {
     }
 
     #[inline(always)]
-    fn any(&self, bvh: &Bvh8, ray: &Ray) -> bool {
+    fn any(&self, bvh: &Bvh8, ray: &RayA) -> bool {
         #[cfg(target_arch = "x86_64")]
         if let Some(brute) = &self.brute {
             // SAFETY: as in `closest`.
@@ -337,7 +344,7 @@ fn bvh_hit(bvh: &Bvh8, found: Found) -> Option<Hit> {
 /// its traversal prefetches).
 #[cold]
 #[inline(never)]
-fn closest_deep(bvh: &Bvh8, ray: &Ray, tmax: f32, isa: Isa) -> Found {
+fn closest_deep(bvh: &Bvh8, ray: &RayA, tmax: f32, isa: Isa) -> Found {
     let stack = &mut heap_stack(bvh.depth);
     dispatch!(isa, true, closest_avx512, closest_avx2, closest_portable, (bvh, ray, tmax, stack))
 }
@@ -345,7 +352,7 @@ fn closest_deep(bvh: &Bvh8, ray: &Ray, tmax: f32, isa: Isa) -> Found {
 /// Any hit in a tree too deep for the fixed stack.
 #[cold]
 #[inline(never)]
-fn any_deep(bvh: &Bvh8, ray: &Ray, isa: Isa) -> bool {
+fn any_deep(bvh: &Bvh8, ray: &RayA, isa: Isa) -> bool {
     let stack = &mut heap_stack(bvh.depth);
     dispatch!(isa, true, any_avx512, any_avx2, any_portable, (bvh, ray, stack))
 }
@@ -368,13 +375,13 @@ fn heap_stack(depth: usize) -> Vec<MaybeUninit<traverse::Entry>> {
 fn disks_closest(
     disks: &[u32],
     shapes: &[Shape],
-    ray: &Ray,
+    ray: &RayA,
     mut best: Option<Hit>,
     mut tmax: f32,
 ) -> (Option<Hit>, f32) {
     for &shape in disks {
         let Geometry::Disk(disk) = &shapes[shape as usize].geometry else { continue };
-        let Some(t) = disk.intersect(&Ray { o: ray.o, d: ray.d, tmax: ray.tmax }) else { continue };
+        let Some(t) = disk.intersect(&ray.ray()) else { continue };
         if t < tmax || (t == tmax && best.is_some_and(|b| shape < b.shape)) {
             tmax = t;
             best = Some(Hit { shape, prim: 0, b1: 0.0, b2: 0.0, t, lane: NO_LANE });
@@ -385,7 +392,8 @@ fn disks_closest(
 
 /// True when a disk blocks the ray in (0, ray.tmax).
 #[inline(never)]
-fn disks_any(disks: &[u32], shapes: &[Shape], ray: &Ray) -> bool {
+fn disks_any(disks: &[u32], shapes: &[Shape], ray: &RayA) -> bool {
+    let ray = &ray.ray();
     disks.iter().any(|&shape| match &shapes[shape as usize].geometry {
         Geometry::Disk(disk) => disk.intersect(ray).is_some(),
         _ => false,
@@ -400,7 +408,7 @@ mod tests;
 /// differences with 0 tests every component.
 #[inline(always)]
 #[allow(clippy::eq_op)] // `s - s` is the finiteness test, not zero
-fn ray_is_finite(ray: &Ray) -> bool {
-    let s = Vec3A::from(ray.o) + Vec3A::from(ray.d);
+fn ray_is_finite(ray: &RayA) -> bool {
+    let s = ray.o + ray.d;
     (s - s).cmpeq(Vec3A::ZERO).all()
 }

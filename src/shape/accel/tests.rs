@@ -114,9 +114,10 @@ fn traversals_of_every_isa_agree() {
                 let bvh = a.bvh.as_ref().unwrap();
                 // The heap-stack traversals (trees too deep for the fixed stack) are the same code.
                 let tmax = r.tmax;
-                let (f, g) = (closest_deep(bvh, &r, tmax, a.isa), a.closest(bvh, &r, tmax));
+                let ra = r.to_a();
+                let (f, g) = (closest_deep(bvh, &ra, tmax, a.isa), a.closest(bvh, &ra, tmax));
                 assert_eq!((f.lane, f.t.to_bits(), f.b1.to_bits()), (g.lane, g.t.to_bits(), g.b1.to_bits()));
-                assert_eq!(any_deep(bvh, &r, a.isa), occluded);
+                assert_eq!(any_deep(bvh, &ra, a.isa), occluded);
             }
         }
         assert!(hits > 500, "only {hits} hits");

@@ -10,7 +10,7 @@
 
 use super::bvh8::{Bvh8, LaneShade, Node8, EMPTY, LEAF, LEAF_SIZE};
 use super::triangle::WatertightRay;
-use crate::math::{Ray, Vec3};
+use crate::math::{RayA, Vec3};
 use glam::Vec4;
 use std::mem::MaybeUninit;
 
@@ -423,8 +423,8 @@ macro_rules! leaf {
 /// it expands in and the node test inlines.
 macro_rules! closest_body {
     ($bvh:expr, $ray:expr, $tmax:expr, $stack:expr, $node_test:ident, $store:ident, $order:ident, $nearest:ident, $chk:ident) => {{
-        let (bvh, ray, mut tmax, stack): (&Bvh8, &Ray, f32, &mut Stack) = ($bvh, $ray, $tmax, $stack);
-        let tr = TraceRay::new(ray.o, ray.d);
+        let (bvh, ray, mut tmax, stack): (&Bvh8, &RayA, f32, &mut Stack) = ($bvh, $ray, $tmax, $stack);
+        let tr = TraceRay::new(ray.o.into(), ray.d.into());
         let (nr, wt) = (&tr.node, &tr.wt);
         // The nearest hit so far: its lane (`u32::MAX` while none) and barycentrics; its distance is `tmax`.
         let (mut hit_lane, mut hit_b1, mut hit_b2) = (u32::MAX, 0.0f32, 0.0f32);
@@ -505,9 +505,9 @@ macro_rules! closest_body {
 /// Any-hit traversal with node test `$node_test`: true when a triangle is hit in (0, tmax).
 macro_rules! any_body {
     ($bvh:expr, $ray:expr, $stack:expr, $node_test:ident, $push_rest:ident, $any:ident, $chk:ident) => {{
-        let (bvh, ray, stack): (&Bvh8, &Ray, &mut Stack) = ($bvh, $ray, $stack);
+        let (bvh, ray, stack): (&Bvh8, &RayA, &mut Stack) = ($bvh, $ray, $stack);
         let tmax = ray.tmax;
-        let tr = TraceRay::new(ray.o, ray.d);
+        let tr = TraceRay::new(ray.o.into(), ray.d.into());
         let (nr, wt) = (&tr.node, &tr.wt);
         let mut sp = 0usize;
         let mut cur = bvh.root;
@@ -554,7 +554,7 @@ macro_rules! push_rest_scalar {
 
 /// Closest hit, portable node test.
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t > tmax)`: see the pop in `closest_body`
-pub fn closest_portable<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
+pub fn closest_portable<const PF: bool>(bvh: &Bvh8, ray: &RayA, tmax: f32, stack: &mut Stack) -> Found {
     closest_body!(
         bvh,
         ray,
@@ -569,7 +569,7 @@ pub fn closest_portable<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, stack:
 }
 
 /// Any hit, portable node test.
-pub fn any_portable<const PF: bool>(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+pub fn any_portable<const PF: bool>(bvh: &Bvh8, ray: &RayA, stack: &mut Stack) -> bool {
     any_body!(bvh, ray, stack, node_test_portable_body, push_rest_scalar, any4, checked)
 }
 
@@ -582,7 +582,7 @@ pub fn any_portable<const PF: bool>(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) ->
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t > tmax)`: see the pop in `closest_body`
-pub unsafe fn closest_avx2<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
+pub unsafe fn closest_avx2<const PF: bool>(bvh: &Bvh8, ray: &RayA, tmax: f32, stack: &mut Stack) -> Found {
     closest_body!(bvh, ray, tmax, stack, node_test_avx_body, store_near_avx, order_push_avx2, nearest4, unchecked)
 }
 
@@ -592,7 +592,7 @@ pub unsafe fn closest_avx2<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, sta
 /// As for `closest_avx2`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,bmi1,lzcnt,popcnt")]
-pub unsafe fn any_avx2<const PF: bool>(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+pub unsafe fn any_avx2<const PF: bool>(bvh: &Bvh8, ray: &RayA, stack: &mut Stack) -> bool {
     any_body!(bvh, ray, stack, node_test_avx_body, push_rest_scalar, any4, unchecked)
 }
 
@@ -697,7 +697,7 @@ macro_rules! push_rest_avx512 {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl,avx512bw,avx512dq,bmi1,lzcnt,popcnt")]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(t > tmax)`: see the pop in `closest_body`
-pub unsafe fn closest_avx512<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, stack: &mut Stack) -> Found {
+pub unsafe fn closest_avx512<const PF: bool>(bvh: &Bvh8, ray: &RayA, tmax: f32, stack: &mut Stack) -> Found {
     closest_body!(
         bvh,
         ray,
@@ -717,6 +717,6 @@ pub unsafe fn closest_avx512<const PF: bool>(bvh: &Bvh8, ray: &Ray, tmax: f32, s
 /// As for `closest_avx512`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl,avx512bw,avx512dq,bmi1,lzcnt,popcnt")]
-pub unsafe fn any_avx512<const PF: bool>(bvh: &Bvh8, ray: &Ray, stack: &mut Stack) -> bool {
+pub unsafe fn any_avx512<const PF: bool>(bvh: &Bvh8, ray: &RayA, stack: &mut Stack) -> bool {
     any_body!(bvh, ray, stack, node_test_avx512_body, push_rest_avx512, any4_avx512, unchecked)
 }
