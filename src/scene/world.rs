@@ -101,7 +101,9 @@ impl Scene {
     /// (The ray as a [`RayA`]: this body is behind a call that does not inline, see `RayA`.)
     fn ray_intersect_impl(&self, ray_a: &RayA) -> Option<SurfaceInteraction> {
         let hit = self.accel.intersect_a(&self.shapes, ray_a)?;
-        let ray = &ray_a.ray();
+        // The direction from its vector (not through a `Ray` on the stack, whose narrow stores
+        // a wider load could not be forwarded from).
+        let d = Vec3::from(ray_a.d);
         // Each arm returns its record whole (built in the return slot, not copied there). The same
         // dispatch as `Shape::interaction`, written out: calling that with the shape set by struct
         // update compiles the volpath loop around it worse (statue σt 2 `volpath`, 4 spp: +0.9 %
@@ -111,12 +113,12 @@ impl Scene {
             Geometry::Mesh(m) => Some(SurfaceInteraction {
                 shape,
                 ..match self.accel.lane(hit.lane) {
-                    Some((lane, v)) => m.interaction_lane(lane, v, hit.b1, hit.b2, hit.t, ray.d),
-                    None => m.interaction(hit.prim, hit.b1, hit.b2, hit.t, ray.d),
+                    Some((lane, v)) => m.interaction_lane(lane, v, hit.b1, hit.b2, hit.t, d),
+                    None => m.interaction(hit.prim, hit.b1, hit.b2, hit.t, d),
                 }
             }),
-            Geometry::Sphere(s) => Some(SurfaceInteraction { shape, ..s.interaction(hit.t, ray) }),
-            Geometry::Disk(d) => Some(SurfaceInteraction { shape, ..d.interaction(hit.t, ray) }),
+            Geometry::Sphere(s) => Some(SurfaceInteraction { shape, ..s.interaction(hit.t, &ray_a.ray()) }),
+            Geometry::Disk(disk) => Some(SurfaceInteraction { shape, ..disk.interaction(hit.t, &ray_a.ray()) }),
         }
     }
 
