@@ -182,7 +182,7 @@ fn opaque_shadow_rays_equal_the_walk() {
         for opaque in [true, false] {
             scene.surfaces_block_shadow_rays = opaque;
             let (mut sampler, mut stats) = (Sampler::new(5, i as u64), LocalStats::default());
-            let tr = shadow_transmittance(&scene, ray, medium, channel, &mut sampler, &mut stats);
+            let tr = shadow_transmittance(&scene, ray.to_a(), medium, channel, &mut sampler, &mut stats);
             results.push((tr.to_array().map(f32::to_bits), sampler.next_1d().to_bits(), stats.rays));
         }
         assert_eq!(results[0], results[1], "ray {ray:?} medium {medium:?}");

@@ -38,7 +38,7 @@ use crate::emitter::Emitter;
 use crate::interaction::offset_origin;
 use crate::interaction::{DirectionSample, SurfaceInteraction};
 use crate::math::INV_FOUR_PI;
-use crate::math::{mis_weight, Ray};
+use crate::math::{mis_weight, Ray, RayA};
 use crate::math::{Vec2, Vec3};
 use crate::medium::Homogeneous;
 use crate::sampler::Sampler;
@@ -62,7 +62,7 @@ pub fn sample_emitter(
         return (Spectrum::ZERO, ds);
     }
     let (ray, medium) = shadow_ray(scene, r, medium, &ds);
-    let tr = shadow_transmittance(scene, ray, medium, channel, sampler, stats);
+    let tr = shadow_transmittance(scene, ray.to_a(), medium, channel, sampler, stats);
     (emitted * tr, ds)
 }
 
@@ -169,10 +169,11 @@ pub fn constant_sphere_lights(scene: &Scene) -> Vec<Option<(Vec3, f32)>> {
 /// Distance first, as Mitsuba: in a medium the free-flight distance `t` is sampled before the
 /// segment is traced, and the ray is traced only up to `t` (a surface hit before it ends the
 /// segment; none means a real collision, and a homogeneous medium, without null density, gives 0).
-/// The walk is `walk_segments`'s, with the same samples in the same order.
+/// The walk is `walk_segments`'s, with the same samples in the same order. The ray comes as a
+/// [`RayA`] (this function does not inline; see `RayA`).
 pub fn shadow_transmittance(
     scene: &Scene,
-    mut ray: Ray,
+    mut ray: RayA,
     mut medium: Option<u32>,
     channel: usize,
     sampler: &mut Sampler,
@@ -202,7 +203,7 @@ pub fn shadow_transmittance(
 #[inline(always)]
 fn shadow_segment(
     scene: &Scene,
-    ray: &mut Ray,
+    ray: &mut RayA,
     medium: &mut Option<u32>,
     remaining: &mut f32,
     tr: &mut Spectrum,
@@ -219,7 +220,7 @@ fn shadow_segment(
     ray.tmax = if t < *remaining { t.next_up() } else { *remaining };
     stats.rays += 1;
     // The hit alone (`Scene::ray_intersect`'s query); the crossing below builds what it needs of it.
-    let hit = scene.accel.intersect_inline(&scene.shapes, ray);
+    let hit = scene.accel.intersect_a(&scene.shapes, ray);
     let seg = hit.as_ref().map_or(*remaining, |h| h.t);
     if let Some(m) = m {
         if t < seg {
@@ -238,7 +239,8 @@ fn shadow_segment(
         }
     }
     let Some(hit) = hit else { return false };
-    let (p, n, null_transmission) = shadow_crossing(scene, &hit, ray);
+    let d = Vec3::from(ray.d);
+    let (p, n, null_transmission) = shadow_crossing(scene, &hit, &ray.ray());
     *tr *= null_transmission;
     if *tr == Spectrum::ZERO {
         return false;
@@ -246,10 +248,10 @@ fn shadow_segment(
     // `is_medium_transition` and `target_medium` on the crossing's shape and normal.
     let s = &scene.shapes[hit.shape as usize];
     if s.interior.is_some() || s.exterior.is_some() {
-        *medium = if ray.d.dot(n) > 0.0 { s.exterior } else { s.interior };
+        *medium = if d.dot(n) > 0.0 { s.exterior } else { s.interior };
     }
     *remaining -= hit.t;
-    ray.o = offset_origin(p, n, ray.d);
+    ray.o = offset_origin(p, n, d).into();
     true
 }
 
@@ -260,7 +262,7 @@ fn shadow_segment(
 #[inline]
 fn shadow_transmittance_opaque(
     scene: &Scene,
-    mut ray: Ray,
+    mut ray: RayA,
     medium: Option<u32>,
     channel: usize,
     sampler: &mut Sampler,
@@ -275,7 +277,7 @@ fn shadow_transmittance_opaque(
     ray.tmax = if t < remaining { t.next_up() } else { remaining };
     stats.rays += 1;
     // A non-finite ray has no hit in `ray_intersect` (the full walk's query); `ray_test` reports it blocked.
-    if (ray.o + ray.d).is_finite() && scene.ray_test(&ray) {
+    if (ray.o + ray.d).is_finite() && scene.accel.occluded_a(&scene.shapes, &ray) {
         return Spectrum::ZERO;
     }
     let Some(m) = m else { return Spectrum::ONE };

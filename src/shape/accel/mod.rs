@@ -245,7 +245,12 @@ impl Accel {
     /// True when anything blocks the ray in (0, ray.tmax), inlined into the caller (`Scene::ray_test`).
     #[inline(always)]
     pub fn occluded_inline(&self, shapes: &[Shape], ray: &Ray) -> bool {
-        let ray = &ray.to_a();
+        self.occluded_a(shapes, &ray.to_a())
+    }
+
+    /// [`Accel::occluded_inline`] of a [`RayA`].
+    #[inline(always)]
+    pub fn occluded_a(&self, shapes: &[Shape], ray: &RayA) -> bool {
         // A NaN or infinite ray carries no light: report it blocked.
         if !ray_is_finite(ray) {
             return true;
