@@ -202,7 +202,7 @@ impl WatertightRay {
     }
 
     /// The axes (kx, ky, kz) as indices, the shear (sx, sy, sz) and −o in the permuted axes: the
-    /// state as plain numbers, for tests on other layouts (`brute.rs`).
+    /// state as plain numbers, for the same test on other layouts (`brute.rs`).
     #[inline(always)]
     pub fn parts(&self) -> ([usize; 3], [f32; 3], [f32; 3]) {
         let (s, o) = (self.s.to_array(), self.neg_o.to_array());
