@@ -213,10 +213,10 @@ impl Accel {
         self.bvh.as_ref().map_or((0, 0, 0), |b| (b.nodes.len(), b.packets.len(), b.depth))
     }
 
-    /// Closest hit along the ray in (0, ray.tmax): [`Accel::intersect_inline`] as a call of its own
+    /// Closest hit along the ray in (0, ray.tmax): [`Accel::intersect_a`] as a call of its own
     /// (benchmarks and tests count its instructions; the renderer inlines the query).
     pub fn intersect(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
-        self.intersect_inline(shapes, ray)
+        self.intersect_a(shapes, &ray.to_a())
     }
 
     /// True when anything blocks the ray in (0, ray.tmax): [`Accel::occluded_inline`] as a call.
@@ -224,13 +224,8 @@ impl Accel {
         self.occluded_inline(shapes, ray)
     }
 
-    /// Closest hit along the ray in (0, ray.tmax), inlined into the caller.
-    #[inline(always)]
-    pub fn intersect_inline(&self, shapes: &[Shape], ray: &Ray) -> Option<Hit> {
-        self.intersect_a(shapes, &ray.to_a())
-    }
-
-    /// [`Accel::intersect_inline`] of a [`RayA`] (`Scene::ray_intersect`'s bodies take it so).
+    /// Closest hit along the ray in (0, ray.tmax), inlined into the caller (`Scene::ray_intersect`'s
+    /// bodies and the shadow walk, which hold the ray as a [`RayA`]).
     #[inline(always)]
     pub fn intersect_a(&self, shapes: &[Shape], ray: &RayA) -> Option<Hit> {
         // A NaN or infinite ray has no hit; the traversal's nearest-first order needs finite distances.

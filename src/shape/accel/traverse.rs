@@ -480,7 +480,10 @@ macro_rules! closest_body {
                 }
                 if let Some((lane, t, b1, b2)) = leaf!($nearest, wt, at!($chk, bvh.packets, packet), tmax) {
                     (hit_lane, tmax, hit_b1, hit_b2) = ((4 * packet + lane) as u32, t, b1, b2);
-                    prefetch(bvh.lanes.as_ptr().wrapping_add(packet).cast::<LaneShade>().wrapping_add(lane));
+                    if !PF {
+                        // (In a large tree it was requested with the packet, above.)
+                        prefetch(bvh.lanes.as_ptr().wrapping_add(packet).cast::<LaneShade>().wrapping_add(lane));
+                    }
                 }
             } else if cur == DONE {
                 break Found { lane: hit_lane, t: tmax, b1: hit_b1, b2: hit_b2 };
