@@ -86,6 +86,19 @@ pub struct Mesh {
     /// The plane of a flat mesh (meshes up to [`MAX_SAMPLE_TRIANGLES`]; `None` otherwise), which
     /// the volume integrators' emitter-skip test reads (`volpath::surely_usable`).
     pub plane: Option<MeshPlane>,
+    /// Set for Mitsuba's `rectangle` ([`Mesh::set_parallelogram`]): area sampling maps the sample
+    /// onto the whole parallelogram, as Mitsuba's rectangle does, instead of picking a triangle.
+    parallelogram: Option<Parallelogram>,
+}
+
+/// A parallelogram mesh's area sampling: `p = p0 + u·eu + v·ev` for the sample `(u, v)`, normal
+/// `n`, uv = the sample (Mitsuba's `Rectangle::sample_position`: `to_world(2u − 1, 2v − 1, 0)`).
+#[derive(Clone, Copy, Debug)]
+struct Parallelogram {
+    p0: Vec3A,
+    eu: Vec3A,
+    ev: Vec3A,
+    n: Vec3A,
 }
 
 /// The plane a flat mesh lies in (`rectangle`, a flat-shaded quad): every face normal within
@@ -168,6 +181,7 @@ impl Mesh {
             sample_uv: true,
             hit_uv: true,
             plane: None,
+            parallelogram: None,
         };
         mesh.face_frames = mesh.flat_frames();
         mesh.plane = mesh.flat_plane();
@@ -178,6 +192,18 @@ impl Mesh {
             }
         }
         mesh
+    }
+
+    /// Sample area as Mitsuba's `rectangle` does: the sample mapped linearly onto the
+    /// parallelogram spanned at vertex 0 by the edges to vertices 1 and 2 (`rectangle_data`'s
+    /// corners (−1, −1), (1, −1), (−1, 1)), uv = the sample, normal the face normal; the same
+    /// density (1 / area) as the triangle pick it replaces. For a mesh of four vertices whose
+    /// fourth is `v1 + v2 − v0` (not checked beyond a debug assertion).
+    pub fn set_parallelogram(&mut self) {
+        let [p0, p1, p2, p3] = [0, 1, 2, 3].map(|i| Vec3A::from(self.positions[i]));
+        debug_assert!((p1 + p2 - p0 - p3).length() <= 1e-4 * (1.0 + p3.abs().max_element()));
+        let _ = p3;
+        self.parallelogram = Some(Parallelogram { p0, eu: p1 - p0, ev: p2 - p0, n: Vec3A::from(self.face_normals[0]) });
     }
 
     /// The geometric normal (flipped with `flip_normals`) and dp/du of triangle `prim`: both
@@ -396,6 +422,11 @@ impl Mesh {
     /// (b1, b2)), or left zero where nothing reads it (`sample_uv`).
     #[inline(always)]
     pub fn sample_position(&self, sample: Vec2) -> PositionSample {
+        if let Some(pg) = &self.parallelogram {
+            let p = pg.p0 + pg.eu * sample.x + pg.ev * sample.y;
+            let uv = if self.sample_uv { sample } else { Vec2::ZERO };
+            return PositionSample { p: p.into(), n: pg.n.into(), uv, pdf: self.inv_area };
+        }
         // A mesh of zero area has no valid distribution: its first triangle (pdf 1/0 = inf).
         let (prim, sx, _) = self.area_distr.sample(sample.x).unwrap_or((0, 0.5, 0.0));
         let b = warp::square_to_uniform_triangle(Vec2::new(sx, sample.y));
