@@ -88,7 +88,7 @@ pub struct Mesh {
     pub plane: Option<MeshPlane>,
     /// Set for Mitsuba's `rectangle` ([`Mesh::set_parallelogram`]): area sampling maps the sample
     /// onto the whole parallelogram, as Mitsuba's rectangle does, instead of picking a triangle.
-    parallelogram: Option<Parallelogram>,
+    parallelogram: Option<Box<Parallelogram>>,
 }
 
 /// A parallelogram mesh's area sampling: `p = p0 + u·eu + v·ev` for the sample `(u, v)`, normal
@@ -203,7 +203,8 @@ impl Mesh {
         let [p0, p1, p2, p3] = [0, 1, 2, 3].map(|i| Vec3A::from(self.positions[i]));
         debug_assert!((p1 + p2 - p0 - p3).length() <= 1e-4 * (1.0 + p3.abs().max_element()));
         let _ = p3;
-        self.parallelogram = Some(Parallelogram { p0, eu: p1 - p0, ev: p2 - p0, n: Vec3A::from(self.face_normals[0]) });
+        self.parallelogram =
+            Some(Box::new(Parallelogram { p0, eu: p1 - p0, ev: p2 - p0, n: Vec3A::from(self.face_normals[0]) }));
     }
 
     /// The geometric normal (flipped with `flip_normals`) and dp/du of triangle `prim`: both
