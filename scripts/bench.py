@@ -276,6 +276,18 @@ def run_traversal(args, mi, variant):
             finally:
                 dr.set_thread_count(os.cpu_count())
             row.update(embree_closest_mrays=mc, embree_shadow_mrays=ms, embree_hits=hits, embree_blocked=blocked)
+            # The closest rays by where they start (bench_traversal's groups), on the same rays.
+            groups = np.fromfile(os.path.join(rays_dir, name + ".groups"), dtype=np.uint8)
+            row["embree_closest_by_origin"] = {}
+            dr.set_thread_count(1)
+            try:
+                for g, label in enumerate(embree_rays.GROUPS):
+                    sub = arr[:n][groups == g]
+                    if len(sub):
+                        r = embree_rays.time_queries(mi, dr, mi.load_file(row["scene"]), (sub, arr[n:n + 1]), 5)
+                        row["embree_closest_by_origin"][label] = dict(rays=len(sub), hits=r[1], closest_mrays=r[0])
+            finally:
+                dr.set_thread_count(os.cpu_count())
     have_valgrind = not args.no_callgrind and subprocess.run(["which", "valgrind"], capture_output=True).returncode == 0
     for row in rows:
         row["closest_instructions_per_ray"] = row["shadow_instructions_per_ray"] = None
@@ -294,6 +306,18 @@ def run_traversal(args, mi, variant):
         print(f"| {os.path.relpath(r['scene'], ROOT)} | {r['triangles']} | {r['bytes_per_triangle']:.1f} | "
               f"{r['load_s']:.3f} | {r['closest_mrays']:.2f} | {r['shadow_mrays']:.2f} | {embree} | "
               f"{fmt(r['closest_instructions_per_ray'])} | {fmt(r['shadow_instructions_per_ray'])} |")
+    print("\nClosest rays by where they start (M rays/s, one thread; rays from a mesh leaving it or turned into "
+          "it, from an analytic shape likewise):\n")
+    print("| scene | origin | rays | hits | snee | Embree | Embree / snee |")
+    print("|---|---|---|---|---|---|---|")
+    for r in rows:
+        embree = r.get("embree_closest_by_origin") or {}
+        for label, v in r.get("closest_by_origin", {}).items():
+            e = embree.get(label)
+            ratio = "-" if e is None else f"{e['closest_mrays'] / v['closest_mrays']:.2f}"
+            e_rate = "-" if e is None else f"{e['closest_mrays']:.2f}"
+            print(f"| {os.path.relpath(r['scene'], ROOT)} | {label} | {v['rays']} | {v['hits']} | "
+                  f"{v['closest_mrays']:.2f} | {e_rate} | {ratio} |")
     return rows
 
 

@@ -8,7 +8,9 @@ This script loads the same scene in Mitsuba, traces the same rays with
 `Scene::ray_test` (any hit), and reports M rays/s on one thread (Dr.Jit's pool at one thread; the
 best of `--reps` launches, each launch tracing every ray of its kind once, after one warm-up launch
 that compiles the kernel), with the hit and blocked counts to check that both renderers answer the
-same queries. A kernel launch includes Dr.Jit's own work around the Embree calls (the ray arrays in,
+same queries; where bench_traversal also wrote `DIR/<scene>.groups` (one byte per closest ray: from a
+mesh outward or inward, from an analytic shape outward or inward), the closest rays of each group too.
+A kernel launch includes Dr.Jit's own work around the Embree calls (the ray arrays in,
 the hit arrays out), as a render's does.
 
 Usage:
@@ -57,6 +59,10 @@ def time_queries(mi, dr, scene, rays, reps):
     return out
 
 
+# bench_traversal's groups of closest rays (`<scene>.groups`), by index.
+GROUPS = ["mesh outward", "mesh inward", "analytic outward", "analytic inward"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scenes", nargs="+")
@@ -90,6 +96,27 @@ def main():
         if not args.json:
             print(f"{path}: Mitsuba {args.variant} (Embree), {n} rays each: closest {mc:.2f} Mrays/s ({hits} hits), "
                   f"shadow {ms:.2f} Mrays/s ({blocked} blocked); CPU / wall time {cpu_c:.2f}, {cpu_s:.2f}")
+        # The closest rays by where they start (bench_traversal's groups), when it wrote them.
+        groups_path = os.path.join(args.rays_dir, name + ".groups")
+        if os.path.exists(groups_path):
+            groups = np.fromfile(groups_path, dtype=np.uint8)
+            if len(groups) != n:
+                sys.exit(f"{name}.groups: {len(groups)} entries for {n} closest rays")
+            by_group = {}
+            dr.set_thread_count(1)
+            try:
+                for g, label in enumerate(GROUPS):
+                    sub = arr[:n][groups == g]
+                    if len(sub):
+                        r = time_queries(mi, dr, scene, (sub, arr[n:n + 1]), args.reps)
+                        by_group[label] = dict(rays=len(sub), hits=r[1], closest_mrays=r[0])
+            finally:
+                dr.set_thread_count(os.cpu_count())
+            rows[-1]["closest_by_origin"] = by_group
+            if not args.json:
+                for label, v in by_group.items():
+                    print(f"{path}: closest from {label}: {v['rays']} rays, {v['hits']} hits, "
+                          f"{v['closest_mrays']:.2f} Mrays/s")
     if args.json:
         print(json.dumps(rows))
 
