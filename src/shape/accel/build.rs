@@ -20,6 +20,7 @@
 //! partition pass itself, not from the bins.
 
 use super::bvh8::{Bvh8, LaneShade, Node8, EMPTY, LEAF, LEAF_SIZE};
+use super::pages::Pages;
 use super::triangle::TriPacket4;
 use crate::math::Vec3;
 use glam::{Vec3A, Vec4};
@@ -658,7 +659,7 @@ pub fn build(bounds: Vec<Bounds>, triangle: impl Fn(u32) -> ([Vec3; 3], LaneShad
             (packet, lanes)
         })
         .unzip();
-    Some(Bvh8 { nodes, packets, lanes, root, depth })
+    Some(Bvh8 { nodes: Pages::new(nodes), packets: Pages::new(packets), lanes: Pages::new(lanes), root, depth })
 }
 
 #[cfg(test)]

@@ -4,6 +4,7 @@
 //!
 //! Built by the binned SAH builder in [`super::build`].
 
+use super::pages::Pages;
 use super::triangle::TriPacket4;
 use glam::Vec3;
 
@@ -75,11 +76,12 @@ impl LaneShade {
     }
 }
 
+/// The arrays are [`Pages`]: read-only once built, in huge-page memory when large.
 pub struct Bvh8 {
-    pub nodes: Vec<Node8>,
-    pub packets: Vec<TriPacket4>,
+    pub nodes: Pages<Node8>,
+    pub packets: Pages<TriPacket4>,
     /// Per packet and lane: the lane's record ([`LaneShade::EMPTY`] for an unused lane).
-    pub lanes: Vec<[LaneShade; LEAF_SIZE]>,
+    pub lanes: Pages<[LaneShade; LEAF_SIZE]>,
     /// Node 0, or `LEAF | 0` when the whole scene is one packet.
     pub root: u32,
     /// Longest root-to-leaf path in nodes (bounds the traversal stack).

@@ -8,11 +8,13 @@
 //!
 //! Watertightness: primitive boxes are padded, the node test is conservative (Ize 2013) and the
 //! triangle test is watertight, so no ray slips through a shared edge or vertex of a closed mesh
-//! (`tests/accel.rs` checks 1.4 M rays through a closed 1.3 M-triangle sphere).
+//! (`tests/accel.rs` checks 1.4 M rays through a closed 1.3 M-triangle sphere). The tree's large arrays
+//! live in huge-page memory ([`pages`]).
 
 pub mod brute;
 pub mod build;
 pub mod bvh8;
+pub mod pages;
 pub mod traverse;
 pub mod triangle;
 
