@@ -269,25 +269,16 @@ def run_traversal(args, mi, variant):
             name = os.path.splitext(os.path.basename(row["scene"]))[0]
             arr = np.fromfile(os.path.join(rays_dir, name + ".rays"), dtype="<f4").reshape(-1, 7)
             n = len(arr) // 2
+            scene = mi.load_file(row["scene"])
             dr.set_thread_count(1)
             try:
-                mc, hits, _, ms, blocked, _ = embree_rays.time_queries(
-                    mi, dr, mi.load_file(row["scene"]), (arr[:n], arr[n:]), 5)
+                mc, hits, _, ms, blocked, _ = embree_rays.time_queries(mi, dr, scene, (arr[:n], arr[n:]), 5)
             finally:
                 dr.set_thread_count(os.cpu_count())
             row.update(embree_closest_mrays=mc, embree_shadow_mrays=ms, embree_hits=hits, embree_blocked=blocked)
             # The closest rays by where they start (bench_traversal's groups), on the same rays.
-            groups = np.fromfile(os.path.join(rays_dir, name + ".groups"), dtype=np.uint8)
-            row["embree_closest_by_origin"] = {}
-            dr.set_thread_count(1)
-            try:
-                for g, label in enumerate(embree_rays.GROUPS):
-                    sub = arr[:n][groups == g]
-                    if len(sub):
-                        r = embree_rays.time_queries(mi, dr, mi.load_file(row["scene"]), (sub, arr[n:n + 1]), 5)
-                        row["embree_closest_by_origin"][label] = dict(rays=len(sub), hits=r[1], closest_mrays=r[0])
-            finally:
-                dr.set_thread_count(os.cpu_count())
+            row["embree_closest_by_origin"] = embree_rays.closest_by_origin(
+                mi, dr, scene, arr[:n], os.path.join(rays_dir, name + ".groups"), 5)
     have_valgrind = not args.no_callgrind and subprocess.run(["which", "valgrind"], capture_output=True).returncode == 0
     for row in rows:
         row["closest_instructions_per_ray"] = row["shadow_instructions_per_ray"] = None

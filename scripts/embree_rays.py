@@ -63,6 +63,27 @@ def time_queries(mi, dr, scene, rays, reps):
 GROUPS = ["mesh outward", "mesh inward", "analytic outward", "analytic inward"]
 
 
+def closest_by_origin(mi, dr, scene, closest, groups_path, reps):
+    """{group label: {rays, hits, closest_mrays}} for the closest rays `closest` (N, 7) split by
+    bench_traversal's `<scene>.groups` file at `groups_path` (one thread); None when there is no such file."""
+    if not os.path.exists(groups_path):
+        return None
+    groups = np.fromfile(groups_path, dtype=np.uint8)
+    if len(groups) != len(closest):
+        sys.exit(f"{groups_path}: {len(groups)} entries for {len(closest)} closest rays")
+    by_group = {}
+    dr.set_thread_count(1)
+    try:
+        for g, label in enumerate(GROUPS):
+            sub = closest[groups == g]
+            if len(sub):
+                r = time_queries(mi, dr, scene, (sub, closest[:1]), reps)
+                by_group[label] = dict(rays=len(sub), hits=r[1], closest_mrays=r[0])
+    finally:
+        dr.set_thread_count(os.cpu_count())
+    return by_group
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scenes", nargs="+")
@@ -97,21 +118,8 @@ def main():
             print(f"{path}: Mitsuba {args.variant} (Embree), {n} rays each: closest {mc:.2f} Mrays/s ({hits} hits), "
                   f"shadow {ms:.2f} Mrays/s ({blocked} blocked); CPU / wall time {cpu_c:.2f}, {cpu_s:.2f}")
         # The closest rays by where they start (bench_traversal's groups), when it wrote them.
-        groups_path = os.path.join(args.rays_dir, name + ".groups")
-        if os.path.exists(groups_path):
-            groups = np.fromfile(groups_path, dtype=np.uint8)
-            if len(groups) != n:
-                sys.exit(f"{name}.groups: {len(groups)} entries for {n} closest rays")
-            by_group = {}
-            dr.set_thread_count(1)
-            try:
-                for g, label in enumerate(GROUPS):
-                    sub = arr[:n][groups == g]
-                    if len(sub):
-                        r = time_queries(mi, dr, scene, (sub, arr[n:n + 1]), args.reps)
-                        by_group[label] = dict(rays=len(sub), hits=r[1], closest_mrays=r[0])
-            finally:
-                dr.set_thread_count(os.cpu_count())
+        by_group = closest_by_origin(mi, dr, scene, arr[:n], os.path.join(args.rays_dir, name + ".groups"), args.reps)
+        if by_group is not None:
             rows[-1]["closest_by_origin"] = by_group
             if not args.json:
                 for label, v in by_group.items():

@@ -200,9 +200,11 @@ impl Mesh {
     /// density (1 / area) as the triangle pick it replaces. For a mesh of four vertices whose
     /// fourth is `v1 + v2 − v0` (not checked beyond a debug assertion).
     pub fn set_parallelogram(&mut self) {
-        let [p0, p1, p2, p3] = [0, 1, 2, 3].map(|i| Vec3A::from(self.positions[i]));
-        debug_assert!((p1 + p2 - p0 - p3).length() <= 1e-4 * (1.0 + p3.abs().max_element()));
-        let _ = p3;
+        let [p0, p1, p2] = [0, 1, 2].map(|i| Vec3A::from(self.positions[i]));
+        debug_assert!({
+            let p3 = Vec3A::from(self.positions[3]);
+            (p1 + p2 - p0 - p3).length() <= 1e-4 * (1.0 + p3.abs().max_element())
+        });
         self.parallelogram =
             Some(Box::new(Parallelogram { p0, eu: p1 - p0, ev: p2 - p0, n: Vec3A::from(self.face_normals[0]) }));
     }

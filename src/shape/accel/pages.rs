@@ -49,7 +49,7 @@ impl<T: Copy> Pages<T> {
     }
 
     /// The array in its `Vec`.
-    pub fn keep(mut v: Vec<T>) -> Pages<T> {
+    fn keep(mut v: Vec<T>) -> Pages<T> {
         // A `Vec`'s pointer is never null (dangling but aligned when empty).
         let ptr = NonNull::new(v.as_mut_ptr()).expect("a Vec's pointer is never null");
         Pages { ptr, len: v.len(), owner: Owner::Vec(v) }
